@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what the engine, CLI, Python module and native tests need.
+# Idempotent: it only calls apt-get/pip when something is missing.
+set -euo pipefail
+
+APT_PACKAGES=(build-essential cmake pkg-config libopenmesh-dev libeigen3-dev
+              libgtest-dev pybind11-dev nlohmann-json3-dev)
+
+missing=()
+for pkg in "${APT_PACKAGES[@]}"; do
+  dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: apt-get install ${missing[*]}" >&2
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+PYTHON=${PYTHON:-python3}
+if ! "$PYTHON" -c "import pytest, pybind11" >/dev/null 2>&1; then
+  echo "install-deps: pip install pytest pybind11" >&2
+  "$PYTHON" -m pip install -q pytest pybind11
+fi
