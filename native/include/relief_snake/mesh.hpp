@@ -1,0 +1,111 @@
+#pragma once
+// Mesh intake: arrays or files in, a validated triangle mesh out, with a report of
+// everything that was merged, split or refused (nothing is dropped silently).
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+
+namespace relief_snake {
+
+using Vec3 = Eigen::Vector3d;
+
+struct MeshTraits : public OpenMesh::DefaultTraits {
+  typedef OpenMesh::Vec3d Point;
+  typedef OpenMesh::Vec3d Normal;
+};
+using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
+
+/// What intake did with the input. Every input face is accounted for:
+/// input_faces = faces_kept_as_triangles + polygons_triangulated + degenerate_faces + nonmanifold_faces.
+struct MeshReport {
+  std::size_t input_vertices = 0;
+  std::size_t input_faces = 0;
+  std::size_t triangles = 0;                   ///< triangles in the resulting mesh
+  std::size_t polygons_triangulated = 0;       ///< input faces with more than 3 corners, fanned into triangles
+  std::size_t duplicate_vertices_merged = 0;   ///< input vertices with exactly the coordinates of an earlier one
+  std::size_t unreferenced_vertices = 0;       ///< input vertices used by no kept face
+  std::size_t degenerate_faces = 0;            ///< repeated corners or zero area: skipped
+  std::size_t nonmanifold_faces = 0;           ///< would make an edge or vertex non-manifold: refused
+  std::size_t components = 0;                  ///< connected components (by faces)
+  std::size_t boundary_edges = 0;
+  /// One line, e.g. "120000 triangles, 2 components; 3 degenerate faces skipped, 1 non-manifold face refused".
+  std::string summary() const;
+};
+
+/// A triangle mesh with the flat adjacency arrays the snake's inner loops need.
+/// Vertex and face indices are the mesh's own (0-based, dense). Input (file or
+/// array) vertex indices map to mesh vertices through input_to_mesh().
+class Mesh {
+ public:
+  /// V: nv by 3 row-major coordinates; F: nf by 3 zero-based corner indices.
+  /// Throws Error on empty input, out-of-range indices or non-finite coordinates.
+  static Mesh from_triangles(const double* V, std::size_t nv, const std::int64_t* F, std::size_t nf);
+  /// Polygons of any size: face k has corners[offsets[k] .. offsets[k+1]); offsets has nf+1 entries.
+  static Mesh from_polygons(std::vector<Vec3> V, const std::vector<std::int64_t>& corners,
+                            const std::vector<std::size_t>& offsets);
+  /// OBJ, PLY, STL or OFF, read by OpenMesh. Throws Error if unreadable.
+  static Mesh load(const std::string& path);
+
+  int n_vertices() const { return static_cast<int>(positions_.size()); }
+  int n_faces() const { return static_cast<int>(face_vertices_.size() / 3); }
+
+  const Vec3& position(int v) const { return positions_[v]; }
+  /// Corner k (0..2) of face f, counter-clockwise seen from the normal.
+  int face_vertex(int f, int k) const { return face_vertices_[3 * f + k]; }
+  /// Face across the edge opposite corner k of f (that edge joins corners k+1 and k+2), -1 on a boundary.
+  int face_neighbor(int f, int k) const { return face_neighbors_[3 * f + k]; }
+  const Vec3& face_normal(int f) const { return face_normals_[f]; }
+  double face_area(int f) const { return face_areas_[f]; }
+  /// Area-weighted average of the incident face normals, unit length.
+  const Vec3& vertex_normal(int v) const { return vertex_normals_[v]; }
+
+  /// One-ring: vertices adjacent to v, and faces incident to v (CSR storage).
+  const int* neighbors_begin(int v) const { return ring_vertices_.data() + ring_vertex_offsets_[v]; }
+  const int* neighbors_end(int v) const { return ring_vertices_.data() + ring_vertex_offsets_[v + 1]; }
+  const int* faces_begin(int v) const { return ring_faces_.data() + ring_face_offsets_[v]; }
+  const int* faces_end(int v) const { return ring_faces_.data() + ring_face_offsets_[v + 1]; }
+
+  bool is_boundary_vertex(int v) const { return boundary_vertex_[v] != 0; }
+  /// Connected component (by shared edges) of vertex v, 0-based.
+  int component(int v) const { return component_[v]; }
+
+  double average_edge_length() const { return average_edge_length_; }
+  double bbox_diagonal() const { return bbox_diagonal_; }
+
+  /// Number of vertices of the original input (file or arrays).
+  std::size_t input_vertex_count() const { return input_to_mesh_.size(); }
+  /// Mesh vertex of input vertex i, or -1 if that vertex is in no kept face.
+  int input_to_mesh(std::size_t i) const { return input_to_mesh_[i]; }
+  /// Input index of mesh vertex v (the first input vertex merged into it).
+  std::size_t mesh_to_input(int v) const { return mesh_to_input_[v]; }
+
+  const MeshReport& report() const { return report_; }
+  /// The OpenMesh structure the arrays were read from (halfedges, boundary walks).
+  const TriMesh& openmesh() const { return om_; }
+
+ private:
+  void build_arrays();
+
+  TriMesh om_;
+  MeshReport report_;
+  std::vector<Vec3> positions_, face_normals_, vertex_normals_;
+  std::vector<double> face_areas_;
+  std::vector<int> face_vertices_, face_neighbors_;
+  std::vector<int> ring_vertices_, ring_faces_;
+  std::vector<std::size_t> ring_vertex_offsets_, ring_face_offsets_;
+  std::vector<char> boundary_vertex_;
+  std::vector<int> component_;
+  std::vector<int> input_to_mesh_;
+  std::vector<std::size_t> mesh_to_input_;
+  double average_edge_length_ = 0, bbox_diagonal_ = 0;
+};
+
+/// Straight-line (Euclidean) distance between two input vertices: the paper's
+/// tool for estimating the step height h. Throws Error on bad indices.
+double measure_distance(const Mesh& mesh, std::int64_t input_i, std::int64_t input_j);
+
+}  // namespace relief_snake

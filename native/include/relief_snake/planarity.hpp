@@ -1,0 +1,66 @@
+#pragma once
+// Planarity (Section 5.3.1) over geodesic-h neighbourhoods and its bilateral
+// filtering (Eqn. 6, Section 7.2.1), computed lazily: only at the vertices the
+// snake actually reaches, and cached for reuse by later segmentations.
+#include <vector>
+
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+struct PlanarityOptions {
+  double radius = 0;          ///< geodesic neighbourhood radius: the step height h
+  double sigma_s = 0;         ///< bilateral similarity sigma; <= 0: estimate (see PlanarityField::estimate_sigma_s)
+};
+
+/// Planarity P(v) and filtered planarity P^(v) of a mesh for one radius h.
+///
+/// P(v) = (c - v) . n for the least-squares plane (c, n) through the vertices
+/// within geodesic distance h of v (v itself excluded; at least the one-ring),
+/// with n oriented like the vertex normal. P > 0 where v lies below the plane of
+/// its neighbours (a concave crease such as the foot of a relief step), P < 0 at
+/// convex creases (the top edge of the step). Geodesic distances come from a
+/// local fast-marching front limited to radius h.
+///
+/// P^(v) (Eqn. 6 with P(v') in the numerator) averages P over v and its
+/// two-ring with weights W_c(|v - v'|) W_s(P(v) - P(v')), sigma_c = half the
+/// largest distance to a two-ring vertex, sigma_s global (see options).
+///
+/// Values are computed on first use and cached; the object is not thread-safe.
+class PlanarityField {
+ public:
+  PlanarityField(const Mesh& mesh, const PlanarityOptions& options);
+
+  double raw(int v);        ///< P(v)
+  double filtered(int v);   ///< P^(v)
+  /// P^ interpolated linearly inside the face of p.
+  double filtered(const SurfacePoint& p);
+
+  /// Sets sigma_s to the standard deviation of P over the given vertices
+  /// (the paper says "variance"; a Gaussian needs the standard deviation).
+  /// Must be called before the first filtered() if options.sigma_s <= 0.
+  void estimate_sigma_s(const std::vector<int>& sample_vertices);
+  double sigma_s() const { return sigma_s_; }
+  double radius() const { return options_.radius; }
+  const Mesh& mesh() const { return mesh_; }
+
+  /// Number of vertices whose P (resp. P^) has been computed so far.
+  std::size_t raw_count() const { return raw_count_; }
+  std::size_t filtered_count() const { return filtered_count_; }
+
+ private:
+  double compute_raw(int v);
+  double compute_filtered(int v);
+
+  const Mesh& mesh_;
+  PlanarityOptions options_;
+  double sigma_s_ = 0;
+  std::vector<double> raw_, filtered_;  // NaN = not computed yet
+  std::size_t raw_count_ = 0, filtered_count_ = 0;
+  // scratch for the local fast marching, reused between calls
+  std::vector<double> distance_;
+  std::vector<int> touched_;
+};
+
+}  // namespace relief_snake

@@ -1,0 +1,104 @@
+#pragma once
+// segment(): the paper's three phases end to end (Sections 5-7): initial contour
+// from the picks, coarse evolution, refinement, stabilisation, relief region.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+enum class ReliefSide { Left, Right };
+
+/// Parameters of a segmentation. Defaults are the paper's (Section 7.2).
+struct Options {
+  double step_height = 0;          ///< h, the relief's step height (required, > 0)
+  double w_int = 0.25;             ///< W_int for refinement, in (0, 1]
+  bool closed = true;              ///< closed contour around the relief, or open (ends on the mesh boundary)
+  ReliefSide relief_side = ReliefSide::Left;  ///< open contours: side of the relief, seen from outside along the pick order
+
+  // Fixed by the paper; exposed for experiments and the benchmark.
+  double tau = 0.2;                ///< movement step, fraction of the local segment length
+  double epsilon = 0.2;            ///< q_i searched over (1 +- epsilon) h
+  int q_samples = 5;               ///< candidate q_i positions across that range
+  double max_turn_degrees = 160;   ///< snaxels turning more than this are removed
+  int lock_interval = 10;          ///< every this many iterations, lock snaxels that moved < 2 tau l
+  int max_iterations = 3000;       ///< cap per phase
+};
+
+enum class Status {
+  Converged,      ///< every phase stopped because nothing moved any more
+  IterationCap,   ///< at least one phase hit Options::max_iterations
+  Cancelled,      ///< the progress callback asked to stop; the result holds nothing
+};
+const char* to_string(Status status);
+
+struct PhaseStats {
+  std::string name;        ///< "preprocess", "coarse", "refine", "stabilise"
+  int iterations = 0;
+  int snaxels = 0;         ///< at the end of the phase
+  double seconds = 0;
+  bool converged = true;
+};
+
+/// Parameters derived from the mesh and options (Section 7.2), for reports.
+struct DerivedParameters {
+  double coarse_spacing = 0, refine_spacing = 0;  ///< l in each phase
+  double alpha_coarse = 0, beta_coarse = 0, alpha_refine = 0, beta_refine = 0, gamma = 0;
+  double sigma_background = 0;  ///< std. dev. of P^ along the initial contour (Eqn. 9)
+  double sigma_s = 0;           ///< bilateral similarity sigma
+  double w_int = 0, w_f = 1, w_d = 0;
+  double average_edge = 0;
+};
+
+struct Result {
+  Status status = Status::Converged;
+  bool closed = true;
+  std::vector<SurfacePoint> contour;     ///< final snaxels, in order
+  std::vector<Vec3> polyline;            ///< their 3D positions
+  std::vector<std::int64_t> relief_vertices;  ///< input vertex indices inside the contour (or on the relief side)
+  std::vector<PhaseStats> phases;
+  DerivedParameters parameters;
+  std::size_t planarity_vertices = 0;    ///< vertices whose planarity was computed
+  std::vector<std::string> notes;        ///< non-fatal remarks (e.g. open-contour ends extended to the boundary)
+};
+
+/// What the progress callback sees. `contour` is valid only during the call.
+struct Progress {
+  const char* phase = "";
+  int iteration = 0;
+  int snaxels = 0;
+  const std::vector<Vec3>* contour = nullptr;
+};
+/// Called once per iteration; return false to cancel.
+using ProgressCallback = std::function<bool(const Progress&)>;
+
+/// Reusable segmentation of one mesh: keeps the planarity computed for a step
+/// height, so segmenting a second relief with the same h costs only the snake.
+class Segmenter {
+ public:
+  explicit Segmenter(const Mesh& mesh);
+  ~Segmenter();
+  Segmenter(const Segmenter&) = delete;
+  Segmenter& operator=(const Segmenter&) = delete;
+
+  /// picks: input vertex indices, in order (>= 3 closed, >= 2 open).
+  /// Throws Error on bad input or when the snake collapses without meeting a relief.
+  Result segment(const std::vector<std::int64_t>& picks, const Options& options,
+                 const ProgressCallback& progress = {});
+
+ private:
+  struct Cache;
+  const Mesh& mesh_;
+  std::unique_ptr<Cache> cache_;
+};
+
+/// One-shot convenience wrapper around Segmenter.
+Result segment(const Mesh& mesh, const std::vector<std::int64_t>& picks, const Options& options,
+               const ProgressCallback& progress = {});
+
+}  // namespace relief_snake
