@@ -3,7 +3,7 @@ PYTHON ?= python3
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test test-native test-python demo clean
+.PHONY: deps build test test-native test-python test-blender demo clean wheel package
 
 deps:
 	@scripts/install-deps.sh
@@ -18,10 +18,21 @@ test-native: build
 test-python: build
 	$(PYTHON) -m pytest -q tests/python
 
-test: test-native test-python
+# The add-on suite in Debian's Blender 3.4 and in bpy 4.2 (scripts/install-blender.sh installs both).
+test-blender: build
+	@scripts/test-blender.sh
+
+test: test-native test-python test-blender
 
 demo: build
 	@scripts/demo.sh
 
+# Packaging: the relief_snake_core wheel, and the two add-on zips (legacy + 4.2 extension) in dist/.
+wheel: deps
+	@PYTHON=$(PYTHON) scripts/build-wheel.sh
+
+package: deps
+	@PYTHON=$(PYTHON) scripts/package.sh
+
 clean:
-	rm -rf $(BUILD_DIR) dist
+	rm -rf $(BUILD_DIR) dist build-wheel build-package

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 namespace relief_snake {

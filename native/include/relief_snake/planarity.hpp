@@ -2,6 +2,7 @@
 // Planarity (Section 5.3.1) over geodesic-h neighbourhoods and its bilateral
 // filtering (Eqn. 6, Section 7.2.1), computed lazily: only at the vertices the
 // snake actually reaches, and cached for reuse by later segmentations.
+#include <utility>
 #include <vector>
 
 #include "relief_snake/mesh.hpp"
@@ -37,9 +38,17 @@ class PlanarityField {
   /// P^ interpolated linearly inside the face of p.
   double filtered(const SurfacePoint& p);
 
+  /// The geodesic ball used by raw(v): the vertices within geodesic distance
+  /// radius() of v (v excluded; fast-marching distances, not the one-ring
+  /// fallback), in the order the front reached them, with their distances.
+  /// Either output may be null.
+  void geodesic_ball(int v, std::vector<int>* vertices, std::vector<double>* distances);
+
   /// Sets sigma_s to the standard deviation of P over the given vertices
   /// (the paper says "variance"; a Gaussian needs the standard deviation).
   /// Must be called before the first filtered() if options.sigma_s <= 0.
+  /// If that deviation is ~0 (a perfectly planar sample), uses 0.01 h so W_s
+  /// stays finite. A changed sigma_s drops the cached P^ values.
   void estimate_sigma_s(const std::vector<int>& sample_vertices);
   double sigma_s() const { return sigma_s_; }
   double radius() const { return options_.radius; }
@@ -52,6 +61,10 @@ class PlanarityField {
  private:
   double compute_raw(int v);
   double compute_filtered(int v);
+  void check_vertex(int v) const;
+  /// Fast marching from v up to radius(); fills ball_ (accepted vertices, v first).
+  void march(int v);
+  void reset_scratch();
 
   const Mesh& mesh_;
   PlanarityOptions options_;
@@ -59,8 +72,12 @@ class PlanarityField {
   std::vector<double> raw_, filtered_;  // NaN = not computed yet
   std::size_t raw_count_ = 0, filtered_count_ = 0;
   // scratch for the local fast marching, reused between calls
-  std::vector<double> distance_;
-  std::vector<int> touched_;
+  std::vector<double> distance_;          // +inf = untouched
+  std::vector<int> touched_;              // vertices whose distance_/accepted_ must be reset
+  std::vector<char> accepted_;
+  std::vector<std::pair<double, int>> heap_;
+  std::vector<int> ball_;
+  std::vector<int> ring_;                 // two-ring scratch for filtered()
 };
 
 }  // namespace relief_snake

@@ -28,6 +28,10 @@ struct Options {
   double max_turn_degrees = 160;   ///< snaxels turning more than this are removed
   int lock_interval = 10;          ///< every this many iterations, lock snaxels that moved < 2 tau l
   int max_iterations = 3000;       ///< cap per phase
+
+  // Normalisation of the feature energy (our reading of 7.2.3, see docs/design.md).
+  double feature_contrast = 0.5;   ///< planarity contrast, in units of h, that scores E_f = -1 at l = h
+  bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
 };
 
 enum class Status {

@@ -1,0 +1,41 @@
+#pragma once
+// The snake's energy terms (Section 5) and their normalisation (7.2.3):
+// tension (Eqn. 3), bending (4), relief-step feature energy (8) and deflation (9).
+#include <vector>
+
+#include "relief_snake/planarity.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+/// E_t(i) = alpha/4 (|v_{i-1} v_i| + |v_i v_{i+1}|)   (Eqn. 3)
+double tension_energy(double alpha, const Vec3& prev, const Vec3& x, const Vec3& next);
+/// E_b(i) = beta (1 - cos theta_i) / (|v_{i-1} v_i| + |v_i v_{i+1}|)^2   (Eqn. 4)
+double bending_energy(double beta, const Vec3& prev, const Vec3& x, const Vec3& next);
+/// E_d(i) at the inside candidate   (Eqn. 9); sigma2_term = gamma sigma^2, or 0 after the coarse phase.
+double deflation_energy(double alpha, double beta, double tau, double local_length, double gamma_sigma2);
+
+/// alpha so that E_t lies in [0, 1] for segment lengths in [0.5 l, 1.5 l].
+double normalise_alpha(double l);
+/// beta so that E_b lies in [0, 1] for segments >= 0.5 l and turns <= max_turn_degrees.
+double normalise_beta(double l, double max_turn_degrees);
+
+/// The relief-step feature energy E_f^3 (Eqn. 8) with q_i searched over
+/// (1 +- epsilon) h along the inward direction (Section 5.3.3).
+class FeatureEnergy {
+ public:
+  FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples);
+  /// E_f at x, with q searched along `inward` from x; gamma applied by the caller.
+  /// Returns (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma).
+  double unscaled(const SurfacePoint& x, const Vec3& inward);
+  /// The q found by the last unscaled() call (for tests and drawing).
+  const SurfacePoint& last_q() const { return last_q_; }
+
+ private:
+  PlanarityField& planarity_;
+  std::vector<double> distances_;
+  std::vector<SurfacePoint> samples_;
+  SurfacePoint last_q_;
+};
+
+}  // namespace relief_snake

@@ -1,0 +1,45 @@
+#pragma once
+// Greedy evolution (Sections 5.1, 6): one iteration moves each snaxel to the
+// lowest-energy of {stay, inside candidate, outside candidate}; a phase repeats
+// iterations with the housekeeping until nothing moves or the cap is hit.
+#include <functional>
+
+#include "relief_snake/energy.hpp"
+#include "relief_snake/segment.hpp"
+#include "relief_snake/snake.hpp"
+
+namespace relief_snake {
+
+/// Everything that differs between the coarse, refinement and stabilisation phases.
+struct PhaseSettings {
+  const char* name = "";
+  double l = 0;               ///< nominal segment length
+  double alpha = 0, beta = 0, gamma = 0;
+  double w_int = 1, w_f = 1, w_d = 1;
+  double gamma_sigma2 = 0;    ///< the -gamma sigma^2 denoising term of Eqn. 9 (coarse only)
+  double tau = 0.2;
+  double max_turn_degrees = 160;
+  int lock_interval = 10;
+  int max_iterations = 3000;
+  int min_snaxels = 4;        ///< fewer means the snake collapsed
+};
+
+struct PhaseOutcome {
+  int iterations = 0;
+  bool converged = false;
+  bool cancelled = false;
+  bool collapsed = false;
+};
+
+/// Energy of snaxel i of `snake` if it were at candidate x (without deflation).
+double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, const Vec3& inward, FeatureEnergy& feature,
+                     const PhaseSettings& phase);
+
+/// One greedy iteration; returns the number of snaxels that moved.
+int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase);
+
+/// Runs a phase to convergence (nothing moved, housekeeping changed nothing) or the cap.
+PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase,
+                       const ProgressCallback& progress);
+
+}  // namespace relief_snake

@@ -1,0 +1,30 @@
+#pragma once
+// The relief region: which mesh vertices a contour encloses (closed) or has on the
+// relief side (open), by cutting the mesh along the traced contour and flooding.
+#include <vector>
+
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+/// Per-mesh-vertex flag (#V entries, 1 = relief) for a contour of snaxels in order
+/// (closed: the last joins the first). inside_left: the relief lies to the left of the
+/// direction of travel seen from outside (normal towards the viewer), i.e. towards n x t.
+///
+/// Each contour segment is traced on the surface (plane section between the two
+/// snaxels, shortest edge path if that fails); every mesh edge the trace crosses is
+/// cut and its endpoints are seeded with their side, read from the mesh orientation
+/// (entering face f across the edge opposite corner k, corner k+1 is on the left).
+/// A competitive breadth-first flood from all seeds over uncut edges then labels
+/// the rest, so a missed crossing only mislabels locally. Vertices no seed reaches
+/// (other components) are not relief. Open contours should end on the mesh boundary.
+std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint>& contour, bool closed,
+                                bool inside_left);
+
+/// True if the closed contour runs counter-clockwise around the region it encloses,
+/// seen from outside: the vector area of its 3D polygon dotted with the average surface
+/// normal along it is positive. Then the inside is to the left (inside_left = true).
+bool contour_orientation_left(const Mesh& mesh, const std::vector<SurfacePoint>& closed_contour);
+
+}  // namespace relief_snake

@@ -1,0 +1,83 @@
+#pragma once
+// The snake: an ordered list of snaxels (surface points) with the paper's
+// housekeeping (Sections 6 and 7.2.2): split/merge to keep spacing in
+// [0.5 l, 1.5 l], removal of sharp turns, and sliding of open ends along the
+// mesh boundary.
+#include <vector>
+
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+struct Snaxel {
+  SurfacePoint point;
+  Vec3 position = Vec3::Zero();
+  bool moved = true;        ///< moved in the last iteration (or is new)
+  bool locked = false;      ///< oscillation lock (Section 6.1)
+  Vec3 anchor = Vec3::Zero();  ///< position at the last lock check
+  int age = 0;              ///< iterations since creation or the last lock check
+};
+
+class Snake {
+ public:
+  Snake(const Mesh& mesh, const std::vector<SurfacePoint>& points, bool closed, bool inside_left);
+
+  int size() const { return static_cast<int>(snaxels_.size()); }
+  bool closed() const { return closed_; }
+  bool inside_left() const { return inside_left_; }
+  Snaxel& operator[](int i) { return snaxels_[i]; }
+  const Snaxel& operator[](int i) const { return snaxels_[i]; }
+  /// Neighbour indices; -1 past the ends of an open snake.
+  int prev(int i) const { return i > 0 ? i - 1 : (closed_ ? size() - 1 : -1); }
+  int next(int i) const { return i + 1 < size() ? i + 1 : (closed_ ? 0 : -1); }
+  bool is_end(int i) const { return !closed_ && (i == 0 || i == size() - 1); }
+
+  /// Moves snaxel i to p.
+  void move(int i, const SurfacePoint& p);
+  /// Unit direction towards the inside (relief side) at snaxel i, in the tangent
+  /// plane: along the bisector of its two segments.
+  Vec3 inward(int i) const;
+  /// l_i = 0.5 (|v_{i-1} v_i| + |v_i v_{i+1}|) (one segment at an open end).
+  double local_length(int i) const;
+  /// Turning angle theta_i in degrees (0 for a straight snake, 0 at open ends).
+  double turn_degrees(int i) const;
+  double length() const;
+
+  /// Removes snaxels turning more than max_degrees; returns how many.
+  int remove_sharp_turns(double max_degrees);
+  /// Splits segments longer than 1.5 l and merges those shorter than 0.5 l;
+  /// returns the number of snaxels added plus removed.
+  int resample(double l);
+  /// Resamples every segment to spacing ~l by walking between consecutive snaxels
+  /// (used when the refinement phase starts with a shorter l).
+  void subdivide(double l);
+  /// Clears moved/locked state for a new phase.
+  void reset_state();
+
+  std::vector<Vec3> polyline() const;
+  std::vector<SurfacePoint> points() const;
+  const Mesh& mesh() const { return mesh_; }
+
+ private:
+  Snaxel make(const SurfacePoint& p) const;
+  const Mesh& mesh_;
+  std::vector<Snaxel> snaxels_;
+  bool closed_, inside_left_;
+};
+
+/// The surface point about halfway between a and b (a straight walk from a
+/// towards b for half their distance).
+SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b);
+/// Points on the surface between a and b at fractions t_k of their distance
+/// (straight walk from a towards b).
+std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b,
+                                          const std::vector<double>& fractions);
+
+/// If p lies on a mesh boundary edge, sets (*face, *edge) to it (edge = opposite corner) and returns true.
+bool boundary_edge_of(const Mesh& mesh, const SurfacePoint& p, int* face, int* edge);
+/// Slides a point on the mesh boundary by `distance` along the boundary loop
+/// (positive: in the loop's direction, i.e. counter-clockwise around the faces).
+SurfacePoint slide_along_boundary(const Mesh& mesh, const SurfacePoint& p, double distance);
+
+}  // namespace relief_snake

@@ -1,0 +1,471 @@
+// relief_snake_core: the engine for Python, without numpy.
+//
+// Arrays come in through the buffer protocol (array.array, memoryview, numpy,
+// Blender's foreach_get buffers) or as plain sequences; they are copied into
+// the engine's double / int64 layout while the GIL is held, then the GIL is
+// released for mesh construction and segmentation. The progress callback
+// re-acquires it. No global state: every call owns its mesh (or the Mesh object
+// does), so independent meshes can be segmented from several threads.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "relief_snake/error.hpp"
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/segment.hpp"
+
+#ifndef RELIEF_SNAKE_VERSION
+#define RELIEF_SNAKE_VERSION "0.0.0"
+#endif
+
+namespace py = pybind11;
+
+namespace relief_snake {
+namespace {
+
+/// Thrown (C++ side) when the progress callback cancels; becomes relief_snake_core.Cancelled.
+struct CancelledError : std::exception {
+  const char* what() const noexcept override { return "segmentation cancelled by the progress callback"; }
+};
+
+// --- reading arrays ----------------------------------------------------------
+
+enum class Kind { Float, Int };
+
+/// Element type of a buffer format string, or false if it is not a plain number type.
+/// Byte-order prefixes other than native are refused: the engine reads native doubles.
+bool parse_format(std::string format, char* code, bool* native_order) {
+  *native_order = true;
+  if (!format.empty() && std::strchr("@=<>!", format[0])) {
+    const char prefix = format[0];
+    format.erase(0, 1);
+    // '<' is native on little-endian x86/ARM; '>' and '!' are big-endian.
+    if (prefix == '>' || prefix == '!') *native_order = false;
+  }
+  if (format.size() != 1) return false;
+  *code = format[0];
+  return true;
+}
+
+bool is_float_code(char c) { return c == 'd' || c == 'f'; }
+bool is_int_code(char c) { return std::strchr("bBhHiIlLqQnN", c) != nullptr; }
+bool is_unsigned_code(char c) { return std::strchr("BHILQN", c) != nullptr; }
+
+/// Reads element k (in logical C order) of a buffer of any strides.
+template <class T>
+T element_at(const py::buffer_info& info, py::ssize_t k) {
+  const char* p = static_cast<const char*>(info.ptr);
+  if (info.ndim == 1) {
+    p += k * info.strides[0];
+  } else {
+    const py::ssize_t cols = info.shape[1];
+    p += (k / cols) * info.strides[0] + (k % cols) * info.strides[1];
+  }
+  T value;
+  std::memcpy(&value, p, sizeof(T));  // memcpy: the buffer need not be aligned
+  return value;
+}
+
+template <class Out>
+bool read_element(const py::buffer_info& info, char code, py::ssize_t k, Out* out) {
+  // Size comes from info.itemsize, not the code: 'l' is 8 bytes here but 4 on Windows.
+  const bool uns = is_unsigned_code(code);
+  if (is_float_code(code)) {
+    if (info.itemsize == 8) *out = static_cast<Out>(element_at<double>(info, k));
+    else if (info.itemsize == 4) *out = static_cast<Out>(element_at<float>(info, k));
+    else return false;
+    return true;
+  }
+  switch (info.itemsize) {
+    case 1: *out = uns ? static_cast<Out>(element_at<std::uint8_t>(info, k)) : static_cast<Out>(element_at<std::int8_t>(info, k)); return true;
+    case 2: *out = uns ? static_cast<Out>(element_at<std::uint16_t>(info, k)) : static_cast<Out>(element_at<std::int16_t>(info, k)); return true;
+    case 4: *out = uns ? static_cast<Out>(element_at<std::uint32_t>(info, k)) : static_cast<Out>(element_at<std::int32_t>(info, k)); return true;
+    case 8:
+      if (uns) {
+        const std::uint64_t u = element_at<std::uint64_t>(info, k);
+        if (u > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) return false;
+        *out = static_cast<Out>(u);
+      } else {
+        *out = static_cast<Out>(element_at<std::int64_t>(info, k));
+      }
+      return true;
+    default: return false;
+  }
+}
+
+std::string type_words(Kind kind) {
+  return kind == Kind::Float ? "float32 or float64 ('f' or 'd')" : "integers (int32/int64/uint32: 'i', 'l', 'q', 'I', 'L')";
+}
+
+/// Copies a buffer of rows of 3 into a flat vector. `what` names the argument in messages.
+template <class Out>
+std::vector<Out> read_buffer(const py::buffer& buffer, Kind kind, const char* what, bool rows_of_three) {
+  py::buffer_info info;
+  try {
+    info = buffer.request();  // strided request: non-contiguous views are read through their strides
+  } catch (py::error_already_set&) {
+    throw Error(std::string(what) + ": cannot read this buffer; pass array.array, a numpy array or a list");
+  }
+  char code = 0;
+  bool native = true;
+  if (!parse_format(info.format, &code, &native) || !(kind == Kind::Float ? is_float_code(code) : is_int_code(code)))
+    throw Error(std::string(what) + " must be " + type_words(kind) + ", got buffer format '" + info.format +
+                "'; convert it (e.g. array.array('" + (kind == Kind::Float ? "d" : "q") + "', ...))");
+  if (!native)
+    throw Error(std::string(what) + " is big-endian; convert it to native byte order first");
+  if (!rows_of_three && info.ndim != 1)
+    throw Error(std::string(what) + " must be 1D, got " + std::to_string(info.ndim) + " dimensions");
+  if (info.ndim == 2) {
+    if (rows_of_three && info.shape[1] != 3)
+      throw Error(std::string(what) + " must have 3 columns, got shape (" + std::to_string(info.shape[0]) + ", " +
+                  std::to_string(info.shape[1]) + ")");
+  } else if (info.ndim != 1) {
+    throw Error(std::string(what) + " must be 1D (flat) or 2D (n by 3), got " + std::to_string(info.ndim) +
+                " dimensions");
+  }
+  const py::ssize_t count = info.ndim == 1 ? info.shape[0] : info.shape[0] * info.shape[1];
+  if (rows_of_three && count % 3 != 0)
+    throw Error(std::string(what) + " has " + std::to_string(count) +
+                " values, not a multiple of 3; pass x, y, z (or 3 corners) per row");
+  std::vector<Out> out(static_cast<std::size_t>(count));
+  for (py::ssize_t k = 0; k < count; ++k)
+    if (!read_element(info, code, k, &out[static_cast<std::size_t>(k)]))
+      throw Error(std::string(what) + ": value " + std::to_string(k) + " does not fit (item size " +
+                  std::to_string(info.itemsize) + ")");
+  return out;
+}
+
+template <class Out>
+Out read_number(py::handle item, Kind kind, const char* what) {
+  if (kind == Kind::Int) {
+    // Refuse floats and strings: an index must be an integer, not something that rounds to one.
+    if (!PyIndex_Check(item.ptr()) || PyBool_Check(item.ptr()))
+      throw Error(std::string(what) + " must contain integers, got " + std::string(py::str(py::type::of(item).attr("__name__"))));
+    const long long v = PyLong_AsLongLong(py::reinterpret_steal<py::object>(PyNumber_Index(item.ptr())).ptr());
+    if (v == -1 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw Error(std::string(what) + " contains an integer too large for 64 bits");
+    }
+    return static_cast<Out>(v);
+  }
+  if (PyFloat_Check(item.ptr()) || (PyIndex_Check(item.ptr()) && !PyBool_Check(item.ptr())) ||
+      PyNumber_Check(item.ptr())) {
+    const double v = PyFloat_AsDouble(item.ptr());
+    if (v == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      throw Error(std::string(what) + " must contain numbers");
+    }
+    return static_cast<Out>(v);
+  }
+  throw Error(std::string(what) + " must contain numbers, got " + std::string(py::str(py::type::of(item).attr("__name__"))));
+}
+
+bool is_sequence(py::handle obj) {
+  return PySequence_Check(obj.ptr()) && !PyUnicode_Check(obj.ptr()) && !PyBytes_Check(obj.ptr());
+}
+
+/// Any supported array-like to a flat vector: buffer, sequence of 3-sequences or flat sequence of numbers.
+template <class Out>
+std::vector<Out> read_array(py::handle obj, Kind kind, const char* what, bool rows_of_three) {
+  if (obj.is_none()) throw Error(std::string(what) + " is None; pass an array or a list of rows");
+  if (PyObject_CheckBuffer(obj.ptr())) return read_buffer<Out>(py::reinterpret_borrow<py::buffer>(obj), kind, what, rows_of_three);
+  if (!is_sequence(obj))
+    throw Error(std::string(what) + " must be a buffer (array.array, numpy) or a sequence, got " +
+                std::string(py::str(py::type::of(obj).attr("__name__"))));
+  const auto seq = py::reinterpret_borrow<py::sequence>(obj);
+  std::vector<Out> out;
+  out.reserve(seq.size() * (rows_of_three ? 3 : 1));
+  std::size_t row = 0;
+  for (py::handle item : seq) {
+    if (is_sequence(item)) {
+      const auto r = py::reinterpret_borrow<py::sequence>(item);
+      if (!rows_of_three || r.size() != 3)
+        throw Error(std::string(what) + ": row " + std::to_string(row) + " has " + std::to_string(r.size()) +
+                    (rows_of_three ? " values, expected 3" : " values, expected a single number"));
+      for (py::handle v : r) out.push_back(read_number<Out>(v, kind, what));
+    } else {
+      out.push_back(read_number<Out>(item, kind, what));
+    }
+    ++row;
+  }
+  if (rows_of_three && out.size() % 3 != 0)
+    throw Error(std::string(what) + " has " + std::to_string(out.size()) +
+                " values, not a multiple of 3; pass x, y, z (or 3 corners) per row");
+  return out;
+}
+
+std::vector<double> read_vertices(py::handle obj) {
+  std::vector<double> V = read_array<double>(obj, Kind::Float, "vertices", true);
+  if (V.empty()) throw Error("vertices is empty; pass at least 3 vertices");
+  for (std::size_t k = 0; k < V.size(); ++k)
+    if (!std::isfinite(V[k]))
+      throw Error("vertex " + std::to_string(k / 3) + " has a non-finite coordinate (NaN or inf); fix the mesh");
+  return V;
+}
+
+std::vector<std::int64_t> read_triangles(py::handle obj, std::size_t n_vertices) {
+  std::vector<std::int64_t> F = read_array<std::int64_t>(obj, Kind::Int, "triangles", true);
+  if (F.empty()) throw Error("triangles is empty; pass at least one triangle");
+  for (std::size_t k = 0; k < F.size(); ++k)
+    if (F[k] < 0 || static_cast<std::uint64_t>(F[k]) >= n_vertices)
+      throw Error("triangle " + std::to_string(k / 3) + " uses vertex " + std::to_string(F[k]) +
+                  ", out of range 0.." + std::to_string(static_cast<long long>(n_vertices) - 1));
+  return F;
+}
+
+std::unique_ptr<Mesh> build_mesh(py::handle vertices, py::handle triangles) {
+  const std::vector<double> V = read_vertices(vertices);
+  const std::vector<std::int64_t> F = read_triangles(triangles, V.size() / 3);
+  py::gil_scoped_release release;
+  return std::make_unique<Mesh>(Mesh::from_triangles(V.data(), V.size() / 3, F.data(), F.size() / 3));
+}
+
+// --- segmentation ---------------------------------------------------------------
+
+Options make_options(double step_height, double w_int, bool open_contour, const std::string& relief_side,
+                     int max_iterations) {
+  if (!std::isfinite(step_height) || step_height <= 0)
+    throw Error("step_height must be a finite number > 0 (measure the relief's step, e.g. with measure())");
+  if (!std::isfinite(w_int) || w_int <= 0 || w_int > 1) throw Error("w_int must be in (0, 1]; the paper uses 0.25");
+  if (relief_side != "left" && relief_side != "right")
+    throw Error("relief_side must be \"left\" or \"right\", got \"" + relief_side + "\"");
+  if (max_iterations < 1) throw Error("max_iterations must be at least 1");
+  Options options;
+  options.step_height = step_height;
+  options.w_int = w_int;
+  options.closed = !open_contour;
+  options.relief_side = relief_side == "left" ? ReliefSide::Left : ReliefSide::Right;
+  options.max_iterations = max_iterations;
+  return options;
+}
+
+std::vector<std::int64_t> read_picks(py::handle picks) {
+  if (picks.is_none()) throw Error("picks is None; pass the picked vertex indices in order");
+  return read_array<std::int64_t>(picks, Kind::Int, "picks", false);
+}
+
+py::tuple point(const Vec3& p) { return py::make_tuple(p.x(), p.y(), p.z()); }
+
+py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, double seconds) {
+  py::list contour;
+  for (const Vec3& p : r.polyline) contour.append(point(p));
+  py::list phases;
+  for (const PhaseStats& s : r.phases) {
+    py::dict phase;
+    phase["name"] = s.name;
+    phase["iterations"] = s.iterations;
+    phase["snaxels"] = s.snaxels;
+    phase["seconds"] = s.seconds;
+    phase["converged"] = s.converged;
+    phases.append(phase);
+  }
+  const DerivedParameters& d = r.parameters;
+  py::dict parameters;
+  parameters["coarse_spacing"] = d.coarse_spacing;
+  parameters["refine_spacing"] = d.refine_spacing;
+  parameters["alpha_coarse"] = d.alpha_coarse;
+  parameters["beta_coarse"] = d.beta_coarse;
+  parameters["alpha_refine"] = d.alpha_refine;
+  parameters["beta_refine"] = d.beta_refine;
+  parameters["gamma"] = d.gamma;
+  parameters["sigma_background"] = d.sigma_background;
+  parameters["sigma_s"] = d.sigma_s;
+  parameters["w_int"] = d.w_int;
+  parameters["w_f"] = d.w_f;
+  parameters["w_d"] = d.w_d;
+  parameters["average_edge"] = d.average_edge;
+  parameters["step_height"] = o.step_height;
+  parameters["open"] = !o.closed;
+  parameters["relief_side"] = o.relief_side == ReliefSide::Left ? "left" : "right";
+  parameters["max_iterations"] = o.max_iterations;
+
+  py::dict out;
+  out["status"] = to_string(r.status);
+  out["closed"] = r.closed;
+  out["contour"] = contour;
+  py::list relief;
+  for (std::int64_t v : r.relief_vertices) relief.append(v);
+  out["relief_vertices"] = relief;
+  out["phases"] = phases;
+  out["parameters"] = parameters;
+  out["planarity_vertices"] = r.planarity_vertices;
+  out["notes"] = py::cast(r.notes);
+  out["mesh_report"] = mesh.report().summary();
+  out["seconds"] = seconds;
+  return out;
+}
+
+/// Runs one segmentation with the GIL released. The Python callback (if any) is
+/// called with the GIL re-acquired; its exception cancels the run and is re-raised here.
+py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lock, py::handle picks_obj,
+                          double step_height, double w_int, bool open_contour, const std::string& relief_side,
+                          int max_iterations, py::object progress, double seconds_before) {
+  const auto start = std::chrono::steady_clock::now();
+  const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations);
+  const std::vector<std::int64_t> picks = read_picks(picks_obj);
+  const auto n_input = static_cast<std::int64_t>(mesh.input_vertex_count());
+  for (std::int64_t p : picks)
+    if (p < 0 || p >= n_input)
+      throw Error("pick " + std::to_string(p) + " is not a vertex index (0.." + std::to_string(n_input - 1) + ")");
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+    throw Error("progress must be a callable progress(phase, iteration, snaxels, contour) or None");
+
+  std::exception_ptr callback_error;
+  ProgressCallback callback;
+  if (!progress.is_none()) {
+    callback = [&progress, &callback_error](const Progress& p) -> bool {
+      py::gil_scoped_acquire acquire;
+      if (callback_error) return false;
+      try {
+        py::list contour;
+        if (p.contour)
+          for (const Vec3& v : *p.contour) contour.append(point(v));
+        py::object answer = progress(py::str(p.phase ? p.phase : ""), p.iteration, p.snaxels, contour);
+        if (answer.is_none()) return true;
+        const int truth = PyObject_IsTrue(answer.ptr());
+        if (truth < 0) throw py::error_already_set();
+        return truth != 0;
+      } catch (...) {
+        // Keep the exception for the caller; the engine unwinds normally on "cancel".
+        callback_error = std::current_exception();
+        return false;
+      }
+    };
+  }
+
+  Result result;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> guard(*lock);  // a Segmenter's cache is not thread-safe
+    try {
+      result = segmenter.segment(picks, options, callback);
+    } catch (...) {
+      if (!callback_error) throw;  // the callback's own exception wins over what the engine made of it
+    }
+  }
+  if (callback_error) std::rethrow_exception(callback_error);
+  if (result.status == Status::Cancelled) throw CancelledError();
+  const double seconds =
+      seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result_dict(result, options, mesh, seconds);
+}
+
+/// The Python Mesh: a validated mesh and its Segmenter (planarity cache), kept together.
+class PyMesh {
+ public:
+  PyMesh(py::handle vertices, py::handle triangles) : mesh_(build_mesh(vertices, triangles)) {
+    py::gil_scoped_release release;
+    segmenter_ = std::make_unique<Segmenter>(*mesh_);
+  }
+
+  py::dict segment(py::handle picks, double step_height, double w_int, bool open_contour,
+                   const std::string& relief_side, int max_iterations, py::object progress) {
+    return run_segmentation(*segmenter_, *mesh_, &lock_, picks, step_height, w_int, open_contour, relief_side,
+                            max_iterations, std::move(progress), 0.0);
+  }
+
+  double measure(std::int64_t i, std::int64_t j) const { return measure_distance(*mesh_, i, j); }
+  const Mesh& mesh() const { return *mesh_; }
+
+ private:
+  std::unique_ptr<Mesh> mesh_;
+  std::unique_ptr<Segmenter> segmenter_;  // holds the planarity cache between segmentations
+  // Locked with the GIL released (never the other way round), so a progress callback can't deadlock.
+  std::mutex lock_;
+};
+
+double measure_vertices(py::handle vertices, std::int64_t i, std::int64_t j) {
+  const std::vector<double> V = read_vertices(vertices);
+  const std::int64_t n = static_cast<std::int64_t>(V.size() / 3);
+  for (std::int64_t k : {i, j})
+    if (k < 0 || k >= n)
+      throw Error("vertex index " + std::to_string(k) + " is out of range 0.." + std::to_string(n - 1));
+  const double dx = V[3 * i] - V[3 * j], dy = V[3 * i + 1] - V[3 * j + 1], dz = V[3 * i + 2] - V[3 * j + 2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+}  // namespace
+}  // namespace relief_snake
+
+PYBIND11_MODULE(relief_snake_core, m) {
+  using namespace relief_snake;
+  m.doc() =
+      "Relief Snake engine: segment a relief on a triangle mesh from a few picked vertices and its step height "
+      "(Segmenting Reliefs on Triangle Meshes, sections 5-7). Arrays go in through the buffer protocol; numpy "
+      "is not needed.";
+  m.attr("__version__") = RELIEF_SNAKE_VERSION;
+
+  py::register_exception<Error>(m, "Error", PyExc_ValueError);
+  py::register_exception<CancelledError>(m, "Cancelled", PyExc_Exception);
+  m.attr("Error").attr("__doc__") = "Bad input or a segmentation that cannot succeed; the message says what to do.";
+  m.attr("Cancelled").attr("__doc__") = "The progress callback returned False.";
+
+  const char* segment_doc =
+      "segment(vertices, triangles, picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left',\n"
+      "        max_iterations=3000, progress=None) -> dict\n\n"
+      "vertices: n by 3 (or flat 3n) floats; triangles: m by 3 (or flat 3m) integer vertex indices;\n"
+      "picks: vertex indices around the relief, in order (>= 3 closed, >= 2 open); step_height: h > 0.\n"
+      "progress(phase: str, iteration: int, snaxels: int, contour: list of (x, y, z)) -> bool|None is called\n"
+      "every iteration; returning False raises Cancelled. Returns a dict with status, closed, contour,\n"
+      "relief_vertices, phases, parameters, planarity_vertices, notes, mesh_report and seconds.";
+
+  m.def(
+      "segment",
+      [](py::handle vertices, py::handle triangles, py::handle picks, double step_height, double w_int,
+         bool open_contour, const std::string& relief_side, int max_iterations, py::object progress) {
+        // Options are checked before the (possibly long) mesh construction.
+        make_options(step_height, w_int, open_contour, relief_side, max_iterations);
+        const auto start = std::chrono::steady_clock::now();
+        std::unique_ptr<Mesh> mesh = build_mesh(vertices, triangles);
+        std::unique_ptr<Segmenter> segmenter;
+        {
+          py::gil_scoped_release release;
+          segmenter = std::make_unique<Segmenter>(*mesh);
+        }
+        std::mutex lock;
+        const double before = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return run_segmentation(*segmenter, *mesh, &lock, picks, step_height, w_int, open_contour, relief_side,
+                                max_iterations, std::move(progress), before);
+      },
+      py::arg("vertices"), py::arg("triangles"), py::arg("picks"), py::arg("step_height"), py::kw_only(),
+      py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
+      py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), segment_doc);
+
+  m.def("measure", &measure_vertices, py::arg("vertices"), py::arg("i"), py::arg("j"),
+        "measure(vertices, i, j) -> float: Euclidean distance between vertices i and j (to estimate h).");
+
+  m.def(
+      "mesh_report",
+      [](py::handle vertices, py::handle triangles) { return build_mesh(vertices, triangles)->report().summary(); },
+      py::arg("vertices"), py::arg("triangles"),
+      "mesh_report(vertices, triangles) -> str: one-line summary of what mesh intake kept, merged or refused.");
+
+  py::class_<PyMesh>(m, "Mesh",
+                     "A validated mesh that keeps its planarity cache between segmentations "
+                     "(segmenting a second relief with the same h costs only the snake).")
+      .def(py::init<py::handle, py::handle>(), py::arg("vertices"), py::arg("triangles"))
+      .def_property_readonly("report", [](const PyMesh& self) { return self.mesh().report().summary(); })
+      .def_property_readonly("n_vertices", [](const PyMesh& self) { return self.mesh().n_vertices(); })
+      .def_property_readonly("n_faces", [](const PyMesh& self) { return self.mesh().n_faces(); })
+      .def_property_readonly("average_edge", [](const PyMesh& self) { return self.mesh().average_edge_length(); })
+      .def("segment", &PyMesh::segment, py::arg("picks"), py::arg("step_height"), py::kw_only(),
+           py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
+           py::arg("max_iterations") = 3000, py::arg("progress") = py::none(),
+           "segment(picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left', "
+           "max_iterations=3000, progress=None) -> dict (see relief_snake_core.segment)")
+      .def("measure", &PyMesh::measure, py::arg("i"), py::arg("j"),
+           "measure(i, j) -> float: Euclidean distance between input vertices i and j.")
+      .def("__repr__", [](const PyMesh& self) {
+        return "<relief_snake_core.Mesh " + self.mesh().report().summary() + ">";
+      });
+}

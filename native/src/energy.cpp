@@ -1,0 +1,64 @@
+#include "relief_snake/energy.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace relief_snake {
+
+double tension_energy(double alpha, const Vec3& prev, const Vec3& x, const Vec3& next) {
+  return 0.25 * alpha * ((x - prev).norm() + (next - x).norm());
+}
+
+double bending_energy(double beta, const Vec3& prev, const Vec3& x, const Vec3& next) {
+  const Vec3 a = x - prev, b = next - x;
+  const double na = a.norm(), nb = b.norm();
+  const double sum = na + nb;
+  if (!(na > 0) || !(nb > 0)) return 0;
+  const double cos_theta = a.dot(b) / (na * nb);
+  return beta * (1 - cos_theta) / (sum * sum);
+}
+
+double deflation_energy(double alpha, double beta, double tau, double l, double gamma_sigma2) {
+  const double t2 = tau * tau;
+  return -0.5 * alpha * (std::sqrt(1 + t2) - 1) * l - 2 * beta * t2 / ((1 + t2) * (1 + t2) * l * l) - gamma_sigma2;
+}
+
+double normalise_alpha(double l) {
+  // E_t in [0.5 alpha l_min, 0.5 alpha l_max] with l_max = 1.5 l.
+  return 1.0 / (0.5 * 1.5 * l);
+}
+
+double normalise_beta(double l, double max_turn_degrees) {
+  // Largest E_b: sharpest allowed turn with both segments at l_min = 0.5 l.
+  const double worst = 1 - std::cos(max_turn_degrees * M_PI / 180.0);
+  const double shortest = 2 * 0.5 * l;
+  return shortest * shortest / worst;
+}
+
+FeatureEnergy::FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples)
+    : planarity_(planarity) {
+  const int n = std::max(1, q_samples);
+  for (int k = 0; k < n; ++k) {
+    const double t = n == 1 ? 0.0 : -1.0 + 2.0 * k / (n - 1);
+    distances_.push_back((1 + t * epsilon) * h);
+  }
+}
+
+double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
+  walk_sampled(planarity_.mesh(), x, inward, distances_, &samples_);
+  if (samples_.empty()) return 0;  // the mesh ends before (1 - eps) h: no step inside
+  double q_value = std::numeric_limits<double>::infinity();
+  for (const SurfacePoint& q : samples_) {
+    const double value = planarity_.filtered(q);
+    if (value < q_value) {
+      q_value = value;
+      last_q_ = q;
+    }
+  }
+  const double px = planarity_.filtered(x);
+  if (!(px > q_value)) return 0;
+  const double d = px - q_value;
+  return d * d;
+}
+
+}  // namespace relief_snake

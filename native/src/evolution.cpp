@@ -1,0 +1,119 @@
+#include "relief_snake/evolution.hpp"
+
+#include <vector>
+
+namespace relief_snake {
+
+double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, const Vec3& inward, FeatureEnergy& feature,
+                     const PhaseSettings& phase) {
+  const Vec3 p = position(snake.mesh(), x);
+  const int ip = snake.prev(i), in = snake.next(i);
+  double internal = 0;
+  if (ip >= 0 && in >= 0) {
+    const Vec3& a = snake[ip].position;
+    const Vec3& b = snake[in].position;
+    internal = tension_energy(phase.alpha, a, p, b) + bending_energy(phase.beta, a, p, b);
+  } else if (ip >= 0 || in >= 0) {
+    // Open end: one segment, counted on both sides so E_t keeps its scale; no bending.
+    const Vec3& a = snake[ip >= 0 ? ip : in].position;
+    internal = tension_energy(phase.alpha, a, p, a);
+  }
+  double energy = phase.w_int * internal;
+  if (phase.w_f != 0 && phase.gamma != 0) energy -= phase.w_f * phase.gamma * feature.unscaled(x, inward);
+  return energy;
+}
+
+int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase) {
+  const Mesh& mesh = snake.mesh();
+  const int n = snake.size();
+  std::vector<char> moved_before(n);
+  for (int i = 0; i < n; ++i) moved_before[i] = snake[i].moved;
+  int moved = 0;
+  for (int i = 0; i < n; ++i) {
+    Snaxel& s = snake[i];
+    s.moved = false;
+    if (s.locked) continue;
+    const int ip = snake.prev(i), in = snake.next(i);
+    // If it and its neighbours stood still last time, its energies are unchanged.
+    if (!moved_before[i] && (ip < 0 || !moved_before[ip]) && (in < 0 || !moved_before[in])) continue;
+
+    const Vec3 inward = snake.inward(i);
+    if (inward.isZero()) continue;
+    const double li = snake.local_length(i);
+    const double step = phase.tau * li;
+    SurfacePoint inside, outside;
+    if (snake.is_end(i)) {
+      // Open ends slide along the mesh boundary.
+      const SurfacePoint a = slide_along_boundary(mesh, s.point, step);
+      const SurfacePoint b = slide_along_boundary(mesh, s.point, -step);
+      const bool a_inside = (position(mesh, a) - s.position).dot(inward) >= 0;
+      inside = a_inside ? a : b;
+      outside = a_inside ? b : a;
+    } else {
+      inside = walk(mesh, s.point, inward, step).end;
+      outside = walk(mesh, s.point, -inward, step).end;
+    }
+    const double e_stay = snaxel_energy(snake, i, s.point, inward, feature, phase);
+    double e_in = snaxel_energy(snake, i, inside, inward, feature, phase);
+    if (phase.w_d != 0)
+      e_in += phase.w_d * deflation_energy(phase.alpha, phase.beta, phase.tau, li, phase.gamma_sigma2);
+    const double e_out = snaxel_energy(snake, i, outside, inward, feature, phase);
+    if (e_in < e_stay && e_in <= e_out) {
+      snake.move(i, inside);
+    } else if (e_out < e_stay && e_out < e_in) {
+      snake.move(i, outside);
+    } else {
+      continue;
+    }
+    snake[i].moved = true;
+    ++moved;
+  }
+  return moved;
+}
+
+PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase,
+                       const ProgressCallback& progress) {
+  PhaseOutcome outcome;
+  const double lock_distance = 2 * phase.tau * phase.l;
+  std::vector<Vec3> polyline;
+  for (int iteration = 1; iteration <= phase.max_iterations; ++iteration) {
+    outcome.iterations = iteration;
+    int changes = greedy_iteration(snake, feature, phase);
+
+    // Oscillation lock (Section 6.1): every lock_interval iterations, a snaxel
+    // that got less than 2 tau l from where it was is frozen for the phase.
+    for (int i = 0; i < snake.size(); ++i) {
+      Snaxel& s = snake[i];
+      if (++s.age < phase.lock_interval || s.locked) continue;
+      if ((s.position - s.anchor).norm() < lock_distance) s.locked = true;
+      s.anchor = s.position;
+      s.age = 0;
+    }
+    changes += snake.remove_sharp_turns(phase.max_turn_degrees);
+    changes += snake.resample(phase.l);
+
+    if (snake.size() < phase.min_snaxels) {
+      outcome.collapsed = true;
+      return outcome;
+    }
+    if (progress) {
+      polyline = snake.polyline();
+      Progress p;
+      p.phase = phase.name;
+      p.iteration = iteration;
+      p.snaxels = snake.size();
+      p.contour = &polyline;
+      if (!progress(p)) {
+        outcome.cancelled = true;
+        return outcome;
+      }
+    }
+    if (changes == 0) {
+      outcome.converged = true;
+      return outcome;
+    }
+  }
+  return outcome;
+}
+
+}  // namespace relief_snake

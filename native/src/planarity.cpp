@@ -1,0 +1,320 @@
+// Planarity over geodesic-h neighbourhoods (Section 5.3.1, 7.2.1) and its
+// bilateral filter (Eqn. 6), computed lazily per vertex and cached.
+#include "relief_snake/planarity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "relief_snake/error.hpp"
+
+namespace relief_snake {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Kimmel-Sethian first-order update of the distance at C from the known
+// distances dA, dB at A and B of the triangle (A, B, C): the planar wavefront
+// d(x) = d_C + g.(x - C) with |g| = 1 through (A, dA) and (B, dB). Returns +inf
+// when the update is not valid (no real solution, or the front reaches C from
+// outside the triangle's angle at C, as happens at obtuse corners); the caller
+// then falls back to the Dijkstra edge updates.
+double triangle_update(const Vec3& A, const Vec3& B, const Vec3& C, double dA, double dB) {
+  const Vec3 e1 = A - C, e2 = B - C;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  if (!(det > 1e-12 * g11 * g22)) return kInf;  // degenerate (needle) triangle
+  // Q = G^-1 with G = X^T X, X = [e1 e2]
+  const double q11 = g22 / det, q12 = -g12 / det, q22 = g11 / det;
+  // |X Q (t - d 1)|^2 = 1 with t = (dA, dB):  a d^2 - 2 b d + c = 0
+  const double a = q11 + 2 * q12 + q22;
+  const double b = (q11 + q12) * dA + (q12 + q22) * dB;
+  const double c = q11 * dA * dA + 2 * q12 * dA * dB + q22 * dB * dB - 1.0;
+  const double disc = b * b - a * c;
+  if (disc < 0 || !(a > 0)) return kInf;
+  const double d = (b + std::sqrt(disc)) / a;
+  if (d < std::max(dA, dB)) return kInf;
+  // Upwind: g = X lambda with lambda = Q (t - d 1); the characteristic reaching
+  // C comes from inside the triangle iff -g lies in the cone of e1, e2.
+  const double l1 = q11 * (dA - d) + q12 * (dB - d);
+  const double l2 = q12 * (dA - d) + q22 * (dB - d);
+  if (l1 > 0 || l2 > 0) return kInf;
+  return d;
+}
+
+// Point-source update (Novotni and Klein 2002): unfold the triangle into its
+// plane, place the virtual source S on the far side of AB with |S - A| = dA and
+// |S - B| = dB, and take |S - C| if the straight ray S -> C crosses AB. Exact on
+// flat regions, where the planar-front update above overestimates near the
+// source by up to ~20% (its front is straight, the true one circular). Returns
+// +inf when not applicable; the caller then uses the planar-front update.
+double point_source_update(const Vec3& A, const Vec3& B, const Vec3& C, double dA, double dB) {
+  const Vec3 ab = B - A, ac = C - A;
+  const double c = ab.norm();
+  if (!(c > 0)) return kInf;
+  const Vec3 ex = ab / c;
+  const double cx = ac.dot(ex);
+  const double cy = (ac - cx * ex).norm();  // C at (cx, cy), cy > 0
+  if (!(cy > 1e-12 * c)) return kInf;
+  const double sx = (dA * dA - dB * dB + c * c) / (2 * c);
+  const double sy2 = dA * dA - sx * sx;
+  if (sy2 < 0) return kInf;  // |dA - dB| > |AB|: no such source
+  const double sy = std::sqrt(sy2);  // S = (sx, -sy)
+  const double t = sy / (cy + sy);    // where S -> C meets the line AB
+  const double xt = sx + t * (cx - sx);
+  if (xt < 0 || xt > c) return kInf;  // the ray passes outside the edge
+  const double d = std::hypot(cx - sx, cy + sy);
+  if (d < std::max(dA, dB)) return kInf;
+  return d;
+}
+
+}  // namespace
+
+PlanarityField::PlanarityField(const Mesh& mesh, const PlanarityOptions& options)
+    : mesh_(mesh), options_(options) {
+  if (!std::isfinite(options.radius) || options.radius <= 0)
+    throw Error("planarity radius (the step height h) must be a positive finite number, got " +
+                std::to_string(options.radius));
+  if (std::isnan(options.sigma_s) || std::isinf(options.sigma_s))
+    throw Error("planarity sigma_s must be finite (or <= 0 to estimate it from the data)");
+  if (options.sigma_s > 0) sigma_s_ = options.sigma_s;
+  const std::size_t n = static_cast<std::size_t>(mesh.n_vertices());
+  raw_.assign(n, kNaN);
+  filtered_.assign(n, kNaN);
+  distance_.assign(n, kInf);
+  accepted_.assign(n, 0);
+}
+
+void PlanarityField::check_vertex(int v) const {
+  if (v < 0 || v >= mesh_.n_vertices())
+    throw Error("vertex index " + std::to_string(v) + " is out of range: the mesh has " +
+                std::to_string(mesh_.n_vertices()) + " vertices");
+}
+
+double PlanarityField::raw(int v) {
+  check_vertex(v);
+  double& value = raw_[v];
+  if (std::isnan(value)) {
+    value = compute_raw(v);
+    ++raw_count_;
+  }
+  return value;
+}
+
+double PlanarityField::filtered(int v) {
+  check_vertex(v);
+  double& value = filtered_[v];
+  if (std::isnan(value)) {
+    const double computed = compute_filtered(v);  // may throw: leave the cache untouched then
+    value = computed;
+    ++filtered_count_;
+  }
+  return value;
+}
+
+double PlanarityField::filtered(const SurfacePoint& p) {
+  if (!p.valid() || p.face >= mesh_.n_faces())
+    throw Error("filtered planarity asked at an invalid surface point (face " + std::to_string(p.face) +
+                "); pass a point on the mesh");
+  return interpolate(mesh_, p, [this](int v) { return filtered(v); });
+}
+
+void PlanarityField::reset_scratch() {
+  // Only the entries this call touched: O(ball), never O(#V).
+  for (int u : touched_) {
+    distance_[u] = kInf;
+    accepted_[u] = 0;
+  }
+  touched_.clear();
+  heap_.clear();
+}
+
+void PlanarityField::march(int v) {
+  const double h = options_.radius;
+  using Entry = std::pair<double, int>;
+  const auto later = std::greater<Entry>();  // min-heap on distance
+  ball_.clear();
+  heap_.clear();
+  touched_.clear();
+
+  distance_[v] = 0;
+  touched_.push_back(v);
+  heap_.emplace_back(0.0, v);
+
+  auto offer = [&](int u, double d) {
+    // Values beyond h can never enter the ball nor serve as upwind values, so skip them.
+    if (!(d <= h) || !(d < distance_[u])) return;
+    if (distance_[u] == kInf) touched_.push_back(u);
+    distance_[u] = d;
+    heap_.emplace_back(d, u);
+    std::push_heap(heap_.begin(), heap_.end(), later);
+  };
+
+  while (!heap_.empty()) {
+    std::pop_heap(heap_.begin(), heap_.end(), later);
+    const Entry top = heap_.back();
+    heap_.pop_back();
+    const int u = top.second;
+    if (accepted_[u] || top.first > distance_[u]) continue;  // stale entry
+    accepted_[u] = 1;
+    ball_.push_back(u);
+    const double du = distance_[u];
+    const Vec3& pu = mesh_.position(u);
+
+    // Dijkstra edge updates: always available, exact along edges.
+    for (const int* it = mesh_.neighbors_begin(u); it != mesh_.neighbors_end(u); ++it) {
+      const int w = *it;
+      if (!accepted_[w]) offer(w, du + (mesh_.position(w) - pu).norm());
+    }
+    // Triangle updates through every face with u and one other accepted corner.
+    for (const int* it = mesh_.faces_begin(u); it != mesh_.faces_end(u); ++it) {
+      const int f = *it;
+      int a = -1, b = -1;
+      for (int k = 0; k < 3; ++k) {
+        const int c = mesh_.face_vertex(f, k);
+        if (c == u) continue;
+        (a < 0 ? a : b) = c;
+      }
+      if (accepted_[a] == accepted_[b]) continue;  // need exactly one known corner besides u
+      if (accepted_[a]) std::swap(a, b);           // now a is the target, b is known
+      const Vec3 &pa = mesh_.position(a), &pb = mesh_.position(b);
+      double d = point_source_update(pu, pb, pa, du, distance_[b]);
+      if (d == kInf) d = triangle_update(pu, pb, pa, du, distance_[b]);
+      offer(a, d);
+    }
+  }
+}
+
+void PlanarityField::geodesic_ball(int v, std::vector<int>* vertices, std::vector<double>* distances) {
+  check_vertex(v);
+  march(v);
+  if (vertices) vertices->assign(ball_.begin() + 1, ball_.end());
+  if (distances) {
+    distances->clear();
+    for (std::size_t i = 1; i < ball_.size(); ++i) distances->push_back(distance_[ball_[i]]);
+  }
+  reset_scratch();
+}
+
+double PlanarityField::compute_raw(int v) {
+  march(v);
+  reset_scratch();
+  // ball_[0] is v itself; the neighbours are the rest.
+  const int* begin = ball_.data() + 1;
+  const int* end = ball_.data() + ball_.size();
+  if (end - begin < 3) {  // h smaller than the edges: fall back to the one-ring
+    begin = mesh_.neighbors_begin(v);
+    end = mesh_.neighbors_end(v);
+  }
+  const std::ptrdiff_t n = end - begin;
+  if (n < 3) return 0.0;  // a plane through v and <= 2 neighbours contains v
+
+  // Work relative to v: P = (c - v) . n needs no absolute coordinates.
+  const Vec3& pv = mesh_.position(v);
+  Vec3 centroid = Vec3::Zero();
+  for (const int* it = begin; it != end; ++it) centroid += mesh_.position(*it) - pv;
+  centroid /= static_cast<double>(n);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const int* it = begin; it != end; ++it) {
+    const Vec3 q = mesh_.position(*it) - pv - centroid;
+    cov.noalias() += q * q.transpose();
+  }
+  cov /= static_cast<double>(n);
+
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov);
+  const Vec3 evals = solver.eigenvalues();  // increasing
+  const Vec3& vn = mesh_.vertex_normal(v);
+  Vec3 normal;
+  if (!(evals(2) > 0)) return 0.0;  // all neighbours coincide
+  if (evals(1) <= 1e-12 * evals(2)) {
+    normal = vn;  // collinear neighbours: the plane's normal is undetermined, use the surface's
+  } else {
+    normal = solver.eigenvectors().col(0);
+    if (normal.dot(vn) < 0) normal = -normal;
+  }
+  return centroid.dot(normal);
+}
+
+double PlanarityField::compute_filtered(int v) {
+  if (!(sigma_s_ > 0))
+    throw Error("programming error: filtered planarity needs sigma_s; call estimate_sigma_s() first or set "
+                "PlanarityOptions::sigma_s > 0");
+  // N(v) = v and its two-ring (edge-hop distance 1 and 2). accepted_ is all
+  // zero between marches, so it serves as the visited mark here.
+  ring_.clear();
+  accepted_[v] = 1;
+  for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it) {
+    if (!accepted_[*it]) {
+      accepted_[*it] = 1;
+      ring_.push_back(*it);
+    }
+  }
+  const std::size_t one_ring = ring_.size();
+  for (std::size_t i = 0; i < one_ring; ++i) {
+    const int w = ring_[i];
+    for (const int* it = mesh_.neighbors_begin(w); it != mesh_.neighbors_end(w); ++it) {
+      if (!accepted_[*it]) {
+        accepted_[*it] = 1;
+        ring_.push_back(*it);
+      }
+    }
+  }
+  accepted_[v] = 0;
+  for (int w : ring_) accepted_[w] = 0;
+
+  const Vec3& pv = mesh_.position(v);
+  double max_dist2 = 0;
+  for (int w : ring_) max_dist2 = std::max(max_dist2, (mesh_.position(w) - pv).squaredNorm());
+  const double pv_raw = raw(v);
+  if (!(max_dist2 > 0)) return pv_raw;
+  // sigma_c = half the largest two-ring distance (Fleishman et al. 2003).
+  const double inv_2sc2 = 1.0 / (2.0 * 0.25 * max_dist2);
+  const double inv_2ss2 = 1.0 / (2.0 * sigma_s_ * sigma_s_);
+
+  double num = pv_raw, den = 1.0;  // v itself: W_c(0) W_s(0) = 1
+  for (int w : ring_) {
+    const double pw = raw(w);
+    const double dp = pv_raw - pw;
+    const double weight =
+        std::exp(-(mesh_.position(w) - pv).squaredNorm() * inv_2sc2 - dp * dp * inv_2ss2);
+    num += weight * pw;  // P(v') in the numerator: Eqn. 6 as printed would be the identity
+    den += weight;
+  }
+  return num / den;
+}
+
+void PlanarityField::estimate_sigma_s(const std::vector<int>& sample_vertices) {
+  if (sample_vertices.empty())
+    throw Error("estimate_sigma_s needs at least one sample vertex (e.g. the vertices along the initial contour)");
+  for (int v : sample_vertices) check_vertex(v);
+  // Two passes over the cached values: numerically safer than sum of squares.
+  double mean = 0;
+  for (int v : sample_vertices) mean += raw(v);
+  mean /= static_cast<double>(sample_vertices.size());
+  double var = 0;
+  for (int v : sample_vertices) {
+    const double d = raw(v) - mean;
+    var += d * d;
+  }
+  var /= static_cast<double>(sample_vertices.size());
+  double sd = std::sqrt(var);
+  // A perfectly planar sample would give sigma_s = 0 and W_s = exp(-x^2/0):
+  // keep W_s finite with a small fraction of h instead.
+  const double floor = 1e-2 * options_.radius;
+  if (!(sd > 1e-6 * options_.radius)) sd = floor;
+  if (sd != sigma_s_ && filtered_count_ > 0) {
+    // The cached P^ were computed with another sigma_s: drop them.
+    std::fill(filtered_.begin(), filtered_.end(), kNaN);
+    filtered_count_ = 0;
+  }
+  sigma_s_ = sd;
+}
+
+}  // namespace relief_snake

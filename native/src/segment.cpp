@@ -1,0 +1,269 @@
+#include "relief_snake/segment.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <unordered_set>
+
+#include "relief_snake/energy.hpp"
+#include "relief_snake/error.hpp"
+#include "relief_snake/evolution.hpp"
+#include "relief_snake/initial_contour.hpp"
+#include "relief_snake/planarity.hpp"
+#include "relief_snake/region.hpp"
+#include "relief_snake/snake.hpp"
+
+namespace relief_snake {
+
+const char* to_string(Status status) {
+  switch (status) {
+    case Status::Converged: return "converged";
+    case Status::IterationCap: return "iteration_cap";
+    case Status::Cancelled: return "cancelled";
+  }
+  return "unknown";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
+
+void validate_options(const Mesh& mesh, const Options& o) {
+  const double h = o.step_height;
+  if (!std::isfinite(h) || h <= 0)
+    throw Error("step height h must be a positive number (got " + fmt(h) +
+                "); measure the relief's step with the measure tool");
+  if (h > mesh.bbox_diagonal())
+    throw Error("step height h = " + fmt(h) + " is larger than the whole mesh (diagonal " +
+                fmt(mesh.bbox_diagonal()) + "); check the units of h");
+  if (!std::isfinite(o.w_int) || o.w_int <= 0 || o.w_int > 1)
+    throw Error("W_int must be in (0, 1] (got " + fmt(o.w_int) + "); try 0.25, then halve it if concavities are missed");
+  if (!(o.tau > 0 && o.tau < 1)) throw Error("tau must be in (0, 1) (got " + fmt(o.tau) + ")");
+  if (!(o.epsilon >= 0 && o.epsilon < 1)) throw Error("epsilon must be in [0, 1) (got " + fmt(o.epsilon) + ")");
+  if (o.q_samples < 1) throw Error("q_samples must be at least 1");
+  if (!(o.max_turn_degrees > 0 && o.max_turn_degrees <= 180))
+    throw Error("max_turn_degrees must be in (0, 180]");
+  if (o.lock_interval < 1) throw Error("lock_interval must be at least 1");
+  if (o.max_iterations < 1) throw Error("max_iterations must be at least 1 (got " + std::to_string(o.max_iterations) + ")");
+  if (!(o.feature_contrast > 0) || !std::isfinite(o.feature_contrast))
+    throw Error("feature_contrast must be a positive number");
+}
+
+std::vector<int> validate_picks(const Mesh& mesh, const std::vector<std::int64_t>& picks, bool closed) {
+  const std::size_t needed = closed ? 3 : 2;
+  if (picks.size() < needed)
+    throw Error(std::string(closed ? "a closed contour" : "an open contour") + " needs at least " +
+                std::to_string(needed) + " picked vertices (got " + std::to_string(picks.size()) +
+                "); pick vertices around the relief");
+  std::vector<int> out;
+  std::unordered_set<int> seen;
+  for (std::size_t k = 0; k < picks.size(); ++k) {
+    const std::int64_t p = picks[k];
+    if (p < 0 || static_cast<std::size_t>(p) >= mesh.input_vertex_count())
+      throw Error("pick " + std::to_string(p) + " is not a vertex index (the mesh has " +
+                  std::to_string(mesh.input_vertex_count()) + " vertices)");
+    const int v = mesh.input_to_mesh(static_cast<std::size_t>(p));
+    if (v < 0) throw Error("pick " + std::to_string(p) + " is a vertex that belongs to no face; pick another vertex");
+    if (!seen.insert(v).second)
+      throw Error("pick " + std::to_string(p) + " is repeated; each picked vertex must be different");
+    if (!out.empty() && mesh.component(v) != mesh.component(out.front()))
+      throw Error("picks " + std::to_string(picks.front()) + " and " + std::to_string(p) +
+                  " lie on different parts of the mesh; pick vertices on the surface around one relief");
+    out.push_back(v);
+  }
+  return out;
+}
+
+// Vertices to estimate the bilateral sigma_s from: the corners along the initial
+// contour plus an even sample of the component, capped for speed.
+std::vector<int> planarity_sample(const Mesh& mesh, const std::vector<SurfacePoint>& contour, int component) {
+  std::vector<int> sample;
+  for (const SurfacePoint& p : contour) sample.push_back(nearest_corner(mesh, p));
+  const int stride = std::max(1, mesh.n_vertices() / 2000);
+  for (int v = 0; v < mesh.n_vertices(); v += stride)
+    if (mesh.component(v) == component) sample.push_back(v);
+  std::sort(sample.begin(), sample.end());
+  sample.erase(std::unique(sample.begin(), sample.end()), sample.end());
+  return sample;
+}
+
+}  // namespace
+
+struct Segmenter::Cache {
+  std::unique_ptr<PlanarityField> planarity;
+  double h = 0;
+};
+
+Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
+Segmenter::~Segmenter() = default;
+
+Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options& options,
+                          const ProgressCallback& progress) {
+  const auto t_start = Clock::now();
+  const Mesh& mesh = mesh_;
+  validate_options(mesh, options);
+  const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
+  const double h = options.step_height;
+
+  Result result;
+  result.closed = options.closed;
+  DerivedParameters& param = result.parameters;
+  param.average_edge = mesh.average_edge_length();
+
+  // --- initial contour (Section 7.1), sampled at l = h ----------------------
+  InitialContour initial = initial_contour(mesh, pick_vertices, options.closed);
+  if (initial.fallback_legs > 0)
+    result.notes.push_back(std::to_string(initial.fallback_legs) +
+                           " leg(s) of the initial contour used a shortest path instead of a plane section");
+  if (!options.closed) {
+    const std::size_t before = initial.path.size();
+    if (!extend_to_boundary(mesh, &initial.path))
+      throw Error("an open contour must end on the mesh boundary, but this part of the mesh has none; "
+                  "use a closed contour");
+    if (initial.path.size() != before)
+      result.notes.push_back("the open contour's ends were extended to the mesh boundary");
+  }
+  std::vector<SurfacePoint> start = resample_path(mesh, initial.path, h, options.closed);
+  if (static_cast<int>(start.size()) < (options.closed ? 4 : 3))
+    throw Error("the picked contour is only " + std::to_string(start.size()) +
+                " step heights long; pick vertices further from the relief or check h");
+  const bool inside_left = options.closed ? contour_orientation_left(mesh, start)
+                                          : options.relief_side == ReliefSide::Left;
+
+  // --- planarity (Sections 5.3, 7.2.1), reused between calls for the same h --
+  if (!cache_->planarity || cache_->h != h) {
+    PlanarityOptions po;
+    po.radius = h;
+    cache_->planarity = std::make_unique<PlanarityField>(mesh, po);
+    cache_->planarity->estimate_sigma_s(planarity_sample(mesh, start, mesh.component(pick_vertices.front())));
+    cache_->h = h;
+  }
+  PlanarityField& planarity = *cache_->planarity;
+  param.sigma_s = planarity.sigma_s();
+  {
+    // sigma of Eqn. 9: spread of P^ along the initial contour, on the background.
+    double sum = 0, sum2 = 0;
+    for (const SurfacePoint& p : start) {
+      const double v = planarity.filtered(p);
+      sum += v;
+      sum2 += v * v;
+    }
+    const double n = static_cast<double>(start.size());
+    param.sigma_background = std::sqrt(std::max(0.0, sum2 / n - (sum / n) * (sum / n)));
+  }
+  const double preprocess_seconds = seconds_since(t_start);
+
+  // --- parameters (Section 7.2) ---------------------------------------------
+  param.coarse_spacing = h;
+  param.refine_spacing = 0.5 * mesh.average_edge_length();
+  param.alpha_coarse = normalise_alpha(param.coarse_spacing);
+  param.beta_coarse = normalise_beta(param.coarse_spacing, options.max_turn_degrees);
+  param.alpha_refine = normalise_alpha(param.refine_spacing);
+  param.beta_refine = normalise_beta(param.refine_spacing, options.max_turn_degrees);
+  // gamma normalises E_f so a step of planarity contrast feature_contrast * h
+  // scores -1 at l = h; like alpha it scales with 1/l between phases (7.2.3).
+  const double contrast = options.feature_contrast * h;
+  param.gamma = 1.0 / (contrast * contrast);
+  param.w_int = options.w_int;
+  param.w_f = 1;
+  param.w_d = 4 - 2 * options.w_int - param.w_f;
+
+  Snake snake(mesh, start, options.closed, inside_left);
+  FeatureEnergy feature(planarity, h, options.epsilon, options.q_samples);
+
+  PhaseSettings base;
+  base.tau = options.tau;
+  base.max_turn_degrees = options.max_turn_degrees;
+  base.lock_interval = options.lock_interval;
+  base.max_iterations = options.max_iterations;
+  base.min_snaxels = options.closed ? 4 : 2;
+
+  PhaseSettings coarse = base;
+  coarse.name = "coarse";
+  coarse.l = param.coarse_spacing;
+  coarse.alpha = param.alpha_coarse;
+  coarse.beta = param.beta_coarse;
+  coarse.gamma = param.gamma;
+  coarse.w_int = coarse.w_f = coarse.w_d = 1;
+  coarse.gamma_sigma2 = param.gamma * param.sigma_background * param.sigma_background;
+
+  PhaseSettings refine = base;
+  refine.name = "refine";
+  refine.l = param.refine_spacing;
+  refine.alpha = param.alpha_refine;
+  refine.beta = param.beta_refine;
+  refine.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / refine.l : param.gamma;
+  refine.w_int = param.w_int;
+  refine.w_f = param.w_f;
+  refine.w_d = param.w_d;
+  refine.gamma_sigma2 = 0;
+
+  PhaseSettings stabilise = refine;
+  stabilise.name = "stabilise";
+  stabilise.w_int = 1;
+  stabilise.w_d = 0;
+
+  PhaseStats pre;
+  pre.name = "preprocess";
+  pre.seconds = preprocess_seconds;
+  pre.snaxels = snake.size();
+  result.phases.push_back(pre);
+
+  bool hit_cap = false;
+  for (PhaseSettings* phase : {&coarse, &refine, &stabilise}) {
+    const auto t_phase = Clock::now();
+    if (phase == &refine) snake.subdivide(refine.l);
+    snake.reset_state();
+    const PhaseOutcome outcome = run_phase(snake, feature, *phase, progress);
+    if (outcome.cancelled) {
+      Result cancelled;
+      cancelled.status = Status::Cancelled;
+      cancelled.closed = options.closed;
+      return cancelled;
+    }
+    if (outcome.collapsed || (options.closed && phase == &coarse && snake.length() < 2 * h))
+      throw Error("the snake collapsed during the " + std::string(phase->name) +
+                  " phase without meeting a relief step; check that h (" + fmt(h) +
+                  ") matches the relief's step height and that the picks surround the relief");
+    PhaseStats stats;
+    stats.name = phase->name;
+    stats.iterations = outcome.iterations;
+    stats.snaxels = snake.size();
+    stats.seconds = seconds_since(t_phase);
+    stats.converged = outcome.converged;
+    hit_cap = hit_cap || !outcome.converged;
+    result.phases.push_back(stats);
+  }
+
+  result.status = hit_cap ? Status::IterationCap : Status::Converged;
+  result.contour = snake.points();
+  result.polyline = snake.polyline();
+
+  // --- the relief region ----------------------------------------------------
+  const std::vector<char> inside = relief_region(mesh, result.contour, options.closed, inside_left);
+  for (std::size_t i = 0; i < mesh.input_vertex_count(); ++i) {
+    const int v = mesh.input_to_mesh(i);
+    if (v >= 0 && inside[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
+  }
+  result.planarity_vertices = planarity.raw_count();
+  return result;
+}
+
+Result segment(const Mesh& mesh, const std::vector<std::int64_t>& picks, const Options& options,
+               const ProgressCallback& progress) {
+  Segmenter segmenter(mesh);
+  return segmenter.segment(picks, options, progress);
+}
+
+}  // namespace relief_snake

@@ -1,0 +1,305 @@
+#include "relief_snake/snake.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace relief_snake {
+
+namespace {
+
+constexpr double kDegrees = 180.0 / M_PI;
+
+// Boundary edge of face g leaving (forward) or entering (backward) vertex v, in
+// the face's counter-clockwise orientation; returns the opposite corner or -1.
+int boundary_edge_at(const Mesh& mesh, int g, int v, bool leaving) {
+  for (int j = 0; j < 3; ++j) {
+    if (mesh.face_neighbor(g, j) >= 0) continue;
+    const int from = mesh.face_vertex(g, (j + 1) % 3), to = mesh.face_vertex(g, (j + 2) % 3);
+    if ((leaving && from == v) || (!leaving && to == v)) return j;
+  }
+  return -1;
+}
+
+}  // namespace
+
+std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b,
+                                          const std::vector<double>& fractions) {
+  const Vec3 pa = position(mesh, a), pb = position(mesh, b);
+  const double d = (pb - pa).norm();
+  std::vector<double> distances;
+  distances.reserve(fractions.size());
+  for (double t : fractions) distances.push_back(t * d);
+  std::vector<SurfacePoint> out;
+  if (d <= 0) return std::vector<SurfacePoint>(fractions.size(), a);
+  walk_sampled(mesh, a, pb - pa, distances, &out);
+  // A boundary can cut the walk short: fill the rest with the last point reached.
+  while (out.size() < fractions.size()) out.push_back(out.empty() ? a : out.back());
+  return out;
+}
+
+SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b) {
+  return surface_between(mesh, a, b, {0.5}).front();
+}
+
+bool boundary_edge_of(const Mesh& mesh, const SurfacePoint& p, int* face, int* edge) {
+  const double tol = 1e-7;
+  for (int k = 0; k < 3; ++k) {
+    if (p.bary[k] <= tol && mesh.face_neighbor(p.face, k) < 0) {
+      *face = p.face;
+      *edge = k;
+      return true;
+    }
+  }
+  // At a corner: look at the faces around it.
+  for (int k = 0; k < 3; ++k) {
+    if (p.bary[k] < 1 - tol) continue;
+    const int v = mesh.face_vertex(p.face, k);
+    for (const int* g = mesh.faces_begin(v); g != mesh.faces_end(v); ++g) {
+      const int j = boundary_edge_at(mesh, *g, v, true);
+      if (j >= 0) {
+        *face = *g;
+        *edge = j;
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+SurfacePoint slide_along_boundary(const Mesh& mesh, const SurfacePoint& p, double distance) {
+  int f, k;
+  if (!boundary_edge_of(mesh, p, &f, &k)) return p;
+  Vec3 b = Vec3::Zero();
+  if (!in_face(mesh, p, f, &b, 1e-7)) return p;
+  const bool forward = distance > 0;
+  double remaining = std::abs(distance);
+  for (int guard = 0; guard < 100000; ++guard) {
+    const int ka = (k + 1) % 3, kb = (k + 2) % 3;
+    const int va = mesh.face_vertex(f, ka), vb = mesh.face_vertex(f, kb);
+    const double len = (mesh.position(vb) - mesh.position(va)).norm();
+    // Fraction of the edge still ahead of the point in the walking direction.
+    const double ahead = forward ? b[ka] / std::max(1e-300, b[ka] + b[kb]) : b[kb] / std::max(1e-300, b[ka] + b[kb]);
+    if (remaining <= ahead * len || len <= 0) {
+      const double t = len > 0 ? remaining / len : 0;
+      double wa = b[ka] / (b[ka] + b[kb]), wb = 1 - wa;
+      if (forward) {
+        wa -= t;
+        wb += t;
+      } else {
+        wa += t;
+        wb -= t;
+      }
+      SurfacePoint out;
+      out.face = f;
+      out.bary = Vec3::Zero();
+      out.bary[ka] = std::clamp(wa, 0.0, 1.0);
+      out.bary[kb] = 1 - out.bary[ka];
+      return out;
+    }
+    remaining -= ahead * len;
+    const int v = forward ? vb : va;
+    int next_face = -1, next_edge = -1;
+    for (const int* g = mesh.faces_begin(v); g != mesh.faces_end(v); ++g) {
+      if (*g == f) continue;
+      const int j = boundary_edge_at(mesh, *g, v, forward);
+      if (j >= 0) {
+        next_face = *g;
+        next_edge = j;
+        break;
+      }
+    }
+    if (next_face < 0) {
+      // A single boundary face can hold two boundary edges meeting at v.
+      const int j = boundary_edge_at(mesh, f, v, forward);
+      if (j >= 0 && j != k) next_face = f, next_edge = j;
+    }
+    if (next_face < 0) return vertex_point(mesh, v);  // boundary ends (non-manifold): stop here
+    f = next_face;
+    k = next_edge;
+    b = Vec3::Zero();
+    for (int j = 0; j < 3; ++j)
+      if (mesh.face_vertex(f, j) == v) b[j] = 1;
+  }
+  return p;
+}
+
+Snake::Snake(const Mesh& mesh, const std::vector<SurfacePoint>& points, bool closed, bool inside_left)
+    : mesh_(mesh), closed_(closed), inside_left_(inside_left) {
+  snaxels_.reserve(points.size());
+  for (const SurfacePoint& p : points) snaxels_.push_back(make(p));
+}
+
+Snaxel Snake::make(const SurfacePoint& p) const {
+  Snaxel s;
+  s.point = p;
+  s.position = relief_snake::position(mesh_, p);
+  s.anchor = s.position;
+  return s;
+}
+
+void Snake::move(int i, const SurfacePoint& p) {
+  snaxels_[i].point = p;
+  snaxels_[i].position = relief_snake::position(mesh_, p);
+}
+
+Vec3 Snake::inward(int i) const {
+  const Vec3& x = snaxels_[i].position;
+  const Vec3 n = normal(mesh_, snaxels_[i].point);
+  const int ip = prev(i), in = next(i);
+  Vec3 t;
+  if (ip < 0) {
+    t = snaxels_[in].position - x;
+  } else if (in < 0) {
+    t = x - snaxels_[ip].position;
+  } else {
+    // Bisector of the two segments is perpendicular to u_next - u_prev.
+    Vec3 up = snaxels_[ip].position - x, un = snaxels_[in].position - x;
+    const double lp = up.norm(), ln = un.norm();
+    if (lp > 0) up /= lp;
+    if (ln > 0) un /= ln;
+    t = un - up;
+    if (t.squaredNorm() < 1e-20) t = snaxels_[in].position - snaxels_[ip].position;
+  }
+  t -= t.dot(n) * n;
+  const double len = t.norm();
+  if (!(len > 0)) return Vec3::Zero();
+  t /= len;
+  Vec3 m = n.cross(t);
+  return inside_left_ ? m : Vec3(-m);
+}
+
+double Snake::local_length(int i) const {
+  const int ip = prev(i), in = next(i);
+  const Vec3& x = snaxels_[i].position;
+  if (ip < 0) return (snaxels_[in].position - x).norm();
+  if (in < 0) return (x - snaxels_[ip].position).norm();
+  return 0.5 * ((x - snaxels_[ip].position).norm() + (snaxels_[in].position - x).norm());
+}
+
+double Snake::turn_degrees(int i) const {
+  const int ip = prev(i), in = next(i);
+  if (ip < 0 || in < 0) return 0;
+  const Vec3 a = snaxels_[i].position - snaxels_[ip].position;
+  const Vec3 b = snaxels_[in].position - snaxels_[i].position;
+  const double na = a.norm(), nb = b.norm();
+  if (!(na > 0) || !(nb > 0)) return 0;
+  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * kDegrees;
+}
+
+double Snake::length() const {
+  double total = 0;
+  for (int i = 0; i + 1 < size(); ++i) total += (snaxels_[i + 1].position - snaxels_[i].position).norm();
+  if (closed_ && size() > 1) total += (snaxels_.front().position - snaxels_.back().position).norm();
+  return total;
+}
+
+int Snake::remove_sharp_turns(double max_degrees) {
+  int removed = 0;
+  for (int i = 0; i < size() && size() > 3;) {
+    if (!is_end(i) && turn_degrees(i) > max_degrees) {
+      snaxels_.erase(snaxels_.begin() + i);
+      ++removed;
+      // The neighbours' turning angles changed: re-check from the previous one.
+      if (i > 0) --i;
+      const int ip = prev(i);
+      if (ip >= 0) snaxels_[ip].moved = true;
+      if (i < size()) snaxels_[i].moved = true;
+    } else {
+      ++i;
+    }
+  }
+  return removed;
+}
+
+int Snake::resample(double l) {
+  const double lmin = 0.5 * l, lmax = 1.5 * l;
+  int changes = 0;
+  std::vector<Snaxel> out;
+  out.reserve(snaxels_.size() + 16);
+  // Split pass: insert midpoints into long segments (as many as needed).
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    out.push_back(snaxels_[i]);
+    const int j = next(i);
+    if (j < 0) continue;
+    const double d = (snaxels_[j].position - snaxels_[i].position).norm();
+    if (d > lmax) {
+      const int pieces = static_cast<int>(std::ceil(d / l));
+      std::vector<double> fractions;
+      for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
+      for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions)) {
+        out.push_back(make(p));
+        ++changes;
+      }
+      out.back().moved = true;
+      snaxels_[i].moved = true;
+    }
+  }
+  snaxels_.swap(out);
+  // Merge pass: replace a too-short pair by its midpoint (open ends stay put).
+  for (int i = 0; i < size() && size() > 3;) {
+    const int j = next(i);
+    if (j < 0) break;
+    const double d = (snaxels_[j].position - snaxels_[i].position).norm();
+    if (d >= lmin) {
+      ++i;
+      continue;
+    }
+    if (is_end(i)) {
+      snaxels_.erase(snaxels_.begin() + j);
+    } else if (is_end(j)) {
+      snaxels_.erase(snaxels_.begin() + i);
+    } else {
+      Snaxel merged = make(surface_midpoint(mesh_, snaxels_[i].point, snaxels_[j].point));
+      merged.moved = true;
+      snaxels_[i] = merged;
+      snaxels_.erase(snaxels_.begin() + j);
+      if (j < i) --i;  // wrapped around a closed snake
+    }
+    ++changes;
+  }
+  return changes;
+}
+
+void Snake::subdivide(double l) {
+  std::vector<Snaxel> out;
+  const int n = size();
+  for (int i = 0; i < n; ++i) {
+    out.push_back(snaxels_[i]);
+    const int j = next(i);
+    if (j < 0) continue;
+    const double d = (snaxels_[j].position - snaxels_[i].position).norm();
+    const int pieces = std::max(1, static_cast<int>(std::lround(d / l)));
+    std::vector<double> fractions;
+    for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
+    if (fractions.empty()) continue;
+    for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions))
+      out.push_back(make(p));
+  }
+  snaxels_.swap(out);
+}
+
+void Snake::reset_state() {
+  for (Snaxel& s : snaxels_) {
+    s.moved = true;
+    s.locked = false;
+    s.anchor = s.position;
+    s.age = 0;
+  }
+}
+
+std::vector<Vec3> Snake::polyline() const {
+  std::vector<Vec3> out;
+  out.reserve(snaxels_.size());
+  for (const Snaxel& s : snaxels_) out.push_back(s.position);
+  return out;
+}
+
+std::vector<SurfacePoint> Snake::points() const {
+  std::vector<SurfacePoint> out;
+  out.reserve(snaxels_.size());
+  for (const Snaxel& s : snaxels_) out.push_back(s.point);
+  return out;
+}
+
+}  // namespace relief_snake

@@ -1,0 +1,239 @@
+#include "relief_snake/surface_point.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace relief_snake {
+
+namespace {
+
+// Barycentric velocity of a unit 3D direction d inside face f: the db with
+// sum(db) = 0 and sum(db_k * P_k) = projection of d onto the face plane.
+Vec3 barycentric_velocity(const Mesh& mesh, int f, const Vec3& d) {
+  const Vec3& a = mesh.position(mesh.face_vertex(f, 0));
+  const Vec3 e1 = mesh.position(mesh.face_vertex(f, 1)) - a;
+  const Vec3 e2 = mesh.position(mesh.face_vertex(f, 2)) - a;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+  const double r1 = d.dot(e1), r2 = d.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  if (!(det > 0)) return Vec3::Zero();
+  const double s = (g22 * r1 - g12 * r2) / det;
+  const double t = (g11 * r2 - g12 * r1) / det;
+  return Vec3(-s - t, s, t);
+}
+
+// Unit projection of d onto the plane of face f (zero if d is normal to it).
+Vec3 project_to_face(const Mesh& mesh, int f, const Vec3& d) {
+  const Vec3& n = mesh.face_normal(f);
+  Vec3 p = d - d.dot(n) * n;
+  const double len = p.norm();
+  return len > 0 ? Vec3(p / len) : Vec3::Zero();
+}
+
+// Unfolds direction d from face f into face g about their shared edge (a, b):
+// the component along the edge is kept, the in-plane perpendicular is rotated.
+Vec3 unfold(const Mesh& mesh, int f, int g, const Vec3& edge_a, const Vec3& edge_b, const Vec3& d) {
+  Vec3 e = edge_b - edge_a;
+  const double len = e.norm();
+  if (!(len > 0)) return project_to_face(mesh, g, d);
+  e /= len;
+  const Vec3 mf = mesh.face_normal(f).cross(e);
+  const Vec3 mg = mesh.face_normal(g).cross(e);
+  Vec3 out = d.dot(e) * e + d.dot(mf) * mg;
+  return project_to_face(mesh, g, out);
+}
+
+}  // namespace
+
+SurfacePoint vertex_point(const Mesh& mesh, int v) {
+  SurfacePoint p;
+  const int* f = mesh.faces_begin(v);
+  if (f == mesh.faces_end(v)) return p;  // isolated vertex: invalid point
+  p.face = *f;
+  for (int k = 0; k < 3; ++k) p.bary[k] = mesh.face_vertex(p.face, k) == v ? 1.0 : 0.0;
+  return p;
+}
+
+Vec3 position(const Mesh& mesh, const SurfacePoint& p) {
+  return p.bary[0] * mesh.position(mesh.face_vertex(p.face, 0)) +
+         p.bary[1] * mesh.position(mesh.face_vertex(p.face, 1)) +
+         p.bary[2] * mesh.position(mesh.face_vertex(p.face, 2));
+}
+
+Vec3 normal(const Mesh& mesh, const SurfacePoint& p) {
+  Vec3 n = p.bary[0] * mesh.vertex_normal(mesh.face_vertex(p.face, 0)) +
+           p.bary[1] * mesh.vertex_normal(mesh.face_vertex(p.face, 1)) +
+           p.bary[2] * mesh.vertex_normal(mesh.face_vertex(p.face, 2));
+  const double len = n.norm();
+  return len > 1e-12 ? Vec3(n / len) : mesh.face_normal(p.face);
+}
+
+bool in_face(const Mesh& mesh, const SurfacePoint& p, int g, Vec3* bary_in_g, double tolerance) {
+  if (p.face == g) {
+    *bary_in_g = p.bary;
+    return true;
+  }
+  Vec3 out = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const double w = p.bary[k];
+    if (w <= tolerance) continue;
+    const int v = mesh.face_vertex(p.face, k);
+    int j = 0;
+    while (j < 3 && mesh.face_vertex(g, j) != v) ++j;
+    if (j == 3) return false;  // a corner with weight is not on g
+    out[j] += w;
+  }
+  const double sum = out.sum();
+  if (!(sum > 0)) return false;
+  *bary_in_g = out / sum;
+  return true;
+}
+
+bool common_face(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b, int* face, Vec3* bary_a,
+                 Vec3* bary_b) {
+  // Candidate faces: a's own face, and the faces around a's corners that carry weight.
+  auto try_face = [&](int g) {
+    if (g < 0) return false;
+    if (in_face(mesh, a, g, bary_a) && in_face(mesh, b, g, bary_b)) {
+      *face = g;
+      return true;
+    }
+    return false;
+  };
+  if (try_face(a.face) || try_face(b.face)) return true;
+  for (int k = 0; k < 3; ++k) {
+    if (a.bary[k] <= 1e-9) continue;
+    const int v = mesh.face_vertex(a.face, k);
+    for (const int* g = mesh.faces_begin(v); g != mesh.faces_end(v); ++g)
+      if (try_face(*g)) return true;
+  }
+  return false;
+}
+
+int nearest_corner(const Mesh& mesh, const SurfacePoint& p) {
+  int k = 0;
+  if (p.bary[1] > p.bary[k]) k = 1;
+  if (p.bary[2] > p.bary[k]) k = 2;
+  return mesh.face_vertex(p.face, k);
+}
+
+Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double distance) {
+  return walk_sampled(mesh, start, direction, {distance}, nullptr);
+}
+
+Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
+                  const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
+  Walk result;
+  result.end = start;
+  if (samples) samples->clear();
+  if (sample_distances.empty() || !start.valid()) return result;
+  const double total = sample_distances.back();
+
+  int f = start.face;
+  Vec3 b = start.bary;
+  Vec3 d = project_to_face(mesh, f, direction);
+  result.direction = d;
+  if (d.isZero() || !(total > 0)) {
+    if (samples)
+      for (double s : sample_distances)
+        if (s <= 0) samples->push_back(start);
+    return result;
+  }
+
+  std::size_t next_sample = 0;
+  double travelled = 0;
+  int previous_face = -1;
+  // Each face crossing consumes at least a tiny distance or changes face; the cap
+  // guards against pathological ping-pong on degenerate geometry.
+  const int max_steps = 100000;
+  for (int step = 0; step < max_steps; ++step) {
+    const Vec3 db = barycentric_velocity(mesh, f, d);
+    // Distance to the first corner weight reaching zero.
+    double t_exit = std::numeric_limits<double>::infinity();
+    int exit_k = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (db[k] < -1e-15) {
+        const double t = std::max(0.0, b[k]) / -db[k];
+        if (t < t_exit) {
+          t_exit = t;
+          exit_k = k;
+        }
+      }
+    }
+    // Emit samples that fall inside this face.
+    while (next_sample < sample_distances.size() && sample_distances[next_sample] - travelled <= t_exit) {
+      const double t = std::max(0.0, sample_distances[next_sample] - travelled);
+      SurfacePoint s{f, b + t * db};
+      s.bary = s.bary.cwiseMax(0.0);
+      s.bary /= s.bary.sum();
+      if (samples) samples->push_back(s);
+      ++next_sample;
+    }
+    if (next_sample == sample_distances.size()) {
+      const double t = total - travelled;
+      result.end.face = f;
+      result.end.bary = (b + t * db).cwiseMax(0.0);
+      result.end.bary /= result.end.bary.sum();
+      result.travelled = total;
+      result.direction = d;
+      return result;
+    }
+    if (exit_k < 0) break;  // direction degenerate in this face
+
+    // Move to the exit edge (opposite corner exit_k).
+    Vec3 e = b + t_exit * db;
+    e[exit_k] = 0;
+    e = e.cwiseMax(0.0);
+    double s = e.sum();
+    if (!(s > 0)) break;
+    e /= s;
+    travelled += t_exit;
+
+    const int g = mesh.face_neighbor(f, exit_k);
+    const int ka = (exit_k + 1) % 3, kb = (exit_k + 2) % 3;
+    if (g < 0) {
+      result.end = SurfacePoint{f, e};
+      result.travelled = travelled;
+      result.hit_boundary = true;
+      result.boundary_face = f;
+      result.boundary_edge = exit_k;
+      result.direction = d;
+      return result;
+    }
+    // Keep the crossing point strictly inside the edge, so a path through a
+    // vertex continues into a definite face instead of stalling on the corner.
+    const double nudge = 1e-9;
+    if (e[ka] < nudge) {
+      e[ka] = nudge;
+      e[kb] = 1 - nudge;
+    } else if (e[kb] < nudge) {
+      e[kb] = nudge;
+      e[ka] = 1 - nudge;
+    }
+    const int va = mesh.face_vertex(f, ka), vb = mesh.face_vertex(f, kb);
+    Vec3 bg = Vec3::Zero();
+    for (int j = 0; j < 3; ++j) {
+      const int v = mesh.face_vertex(g, j);
+      if (v == va) bg[j] = e[ka];
+      else if (v == vb) bg[j] = e[kb];
+    }
+    d = unfold(mesh, f, g, mesh.position(va), mesh.position(vb), d);
+    if (d.isZero()) break;
+    // A zero-length step back into the face we came from means the direction runs
+    // along the shared edge; step a hair into the new face to break the tie.
+    if (g == previous_face && t_exit <= 0) {
+      const Vec3 c(1.0 / 3, 1.0 / 3, 1.0 / 3);
+      bg = (1 - 1e-9) * bg + 1e-9 * c;
+    }
+    previous_face = f;
+    f = g;
+    b = bg;
+  }
+  result.end = SurfacePoint{f, b.cwiseMax(0.0) / b.cwiseMax(0.0).sum()};
+  result.travelled = travelled;
+  result.direction = d;
+  return result;
+}
+
+}  // namespace relief_snake

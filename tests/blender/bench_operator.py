@@ -1,0 +1,80 @@
+"""End-to-end time of mesh.relief_snake_segment on a large synthetic scan, split into
+Blender data transfer (selection + foreach_get reads, vertex group + curve writes) and
+engine time. Not part of the test suite; run in either Blender:
+
+    blender --background --factory-startup --python tests/blender/bench_operator.py -- [TRIANGLES]
+    .venv-bpy/bin/python tests/blender/bench_operator.py [TRIANGLES]
+
+Uses $RELIEF_SNAKE_BUILD_DIR (default build/) for make-scan and relief_snake_core.
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import bpy
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+BUILD = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build"))
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+    triangles = int(argv[0]) if argv else 300000
+    sys.path[:0] = [BUILD, os.path.join(ROOT, "addon"), HERE]
+    import addon_utils
+    import json
+    import plyio
+    from test_addon import select_vertices
+    mod = addon_utils.enable("relief_snake", default_set=True)
+    prefix = os.path.join(tempfile.mkdtemp(prefix="relief-snake-bench-"), "duck")
+    subprocess.run([os.path.join(BUILD, "make-scan"), "--shape", "duck", "--background", "plane",
+                    "--triangles", str(triangles), "--seed", "2", "--out", prefix], check=True,
+                   stdout=subprocess.DEVNULL)
+    truth = json.load(open(prefix + ".truth.json"))
+    verts, faces = plyio.read_ply(prefix + ".ply")
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+    mesh = bpy.data.meshes.new("Scan")
+    mesh.from_pydata(verts, [], faces)
+    obj = bpy.data.objects.new("Scan", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    select_vertices(obj, truth["picks"])
+
+    t0 = time.perf_counter()
+    ret = bpy.ops.mesh.relief_snake_segment('EXEC_DEFAULT', step_height=float(truth["h"]))
+    total = time.perf_counter() - t0
+    s = bpy.context.scene.relief_snake
+    gi = obj.vertex_groups["Relief"].index
+    got = {v.index for v in obj.data.vertices if any(g.group == gi for g in v.groups)}
+    want = set(truth["relief_vertices"])
+    print("bench: Blender %s, %d vertices, %d triangles: %s in %.2f s"
+          % (bpy.app.version_string, len(mesh.vertices), len(mesh.loop_triangles), ret, total))
+    print("bench: " + s.last_summary)
+    for line in s.last_phases.splitlines():
+        print("bench:   " + line)
+    print("bench: IoU %.3f" % (len(got & want) / max(1, len(got | want))))
+
+    # The transfer pieces on their own, a few times each (they are fast).
+    api, mesh_io = mod.api, mod.mesh_io
+    for name, fn in (("selection + click order", lambda: api.selected_picks(obj)),
+                     ("foreach_get vertices + loop triangles", lambda: mesh_io.read_buffers(obj.data)),
+                     ("vertex group write", lambda: mesh_io.write_vertex_group(obj, "Relief", sorted(got)))):
+        best = min(_timed(fn) for _ in range(3))
+        print("bench:   %-40s %.3f s" % (name, best))
+    sys.stdout.flush()
+    os._exit(0)
+
+
+def _timed(fn):
+    t = time.perf_counter()
+    fn()
+    return time.perf_counter() - t
+
+
+if __name__ == "__main__":
+    main()

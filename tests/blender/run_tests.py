@@ -1,0 +1,120 @@
+"""Runs the add-on test suite inside Blender. One suite, two Blenders:
+
+    blender --background --factory-startup --python-exit-code 1 --python tests/blender/run_tests.py
+    .venv-bpy/bin/python tests/blender/run_tests.py
+
+It enables the add-on from addon/, puts the built native module (build/relief_snake_core*.so,
+or $RELIEF_SNAKE_BUILD_DIR) on sys.path, writes a synthetic scan with build/make-scan and
+runs tests/blender/test_*.py. Exit status is non-zero when anything fails, when a test is
+skipped, or when bpy, the native module or make-scan is missing: a suite that did not run
+is a failure.
+
+Development only: RELIEF_SNAKE_FAKE_CORE=1 uses tests/blender/dev/ (a fake engine and a
+Python-made disk scan) and always exits non-zero, so it can never pass for the real thing.
+"""
+
+import glob
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+BUILD = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build"))
+FAKE = os.environ.get("RELIEF_SNAKE_FAKE_CORE") == "1"
+
+
+def _exit(code):
+    sys.stdout.flush()
+    sys.stderr.flush()
+    # os._exit: the same behaviour under `blender --python` and the bpy module (no teardown).
+    os._exit(code)
+
+
+def _fail(message):
+    print("run_tests: FAILED: %s" % message, file=sys.stderr)
+    _exit(1)
+
+
+def make_scan(out_dir):
+    """Writes the test scan and returns (prefix, truth dict)."""
+    prefix = os.environ.get("RELIEF_SNAKE_SCAN")
+    if not prefix:
+        prefix = os.path.join(out_dir, "duck")
+        if FAKE:
+            sys.path.insert(0, os.path.join(HERE, "dev"))
+            import make_disk_scan
+            make_disk_scan.main(prefix)
+        else:
+            tool = os.path.join(BUILD, "make-scan")
+            if not os.path.exists(tool):
+                _fail("%s not found: build it first (make build)" % tool)
+            cmd = [tool, "--shape", "duck", "--background", "plane", "--triangles",
+                   os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "20000"), "--seed", "1", "--out", prefix]
+            subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    with open(prefix + ".truth.json") as f:
+        return prefix, json.load(f)
+
+
+def main():
+    try:
+        import bpy
+    except ImportError:
+        _fail("bpy is not available: run scripts/install-blender.sh and use Blender or .venv-bpy/bin/python")
+    print("run_tests: Blender %s, Python %s" % (bpy.app.version_string, sys.version.split()[0]))
+
+    # The native module, where the add-on's fallback `import relief_snake_core` finds it.
+    if FAKE:
+        sys.path.insert(0, os.path.join(HERE, "dev"))
+        print("run_tests: *** FAKE ENGINE (development only); this run will exit non-zero ***")
+    else:
+        found = glob.glob(os.path.join(BUILD, "relief_snake_core*.so"))
+        if not found:
+            _fail("native module relief_snake_core not found in %s: build it (make build)" % BUILD)
+        sys.path.insert(0, BUILD)
+    try:
+        import relief_snake_core
+    except ImportError as exc:
+        _fail("the native module does not import: %s" % exc)
+    print("run_tests: engine %s from %s" % (getattr(relief_snake_core, "__version__", "?"),
+                                           relief_snake_core.__file__))
+
+    # The add-on, from the source tree, enabled the way Blender enables a legacy add-on.
+    import addon_utils
+    sys.path.insert(0, os.path.join(ROOT, "addon"))
+    mod = addon_utils.enable("relief_snake", default_set=True, handle_error=lambda exc: _fail(
+        "enabling the add-on raised %r" % exc))
+    if mod is None or not hasattr(bpy.types.Scene, "relief_snake"):
+        _fail("the add-on did not register")
+    print("run_tests: add-on from %s" % mod.__file__)
+
+    tmp = tempfile.mkdtemp(prefix="relief-snake-blender-")
+    prefix, truth = make_scan(tmp)
+    sys.path.insert(0, HERE)
+    import test_addon
+    test_addon.configure(prefix, truth, fake=FAKE)
+
+    loader = unittest.TestLoader()
+    suite = unittest.TestSuite()
+    for name in ("test_ordering", "test_addon"):
+        suite.addTests(loader.loadTestsFromName(name))
+    t0 = time.perf_counter()
+    result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)
+    print("run_tests: %d tests in %.1f s (Blender %s)" % (result.testsRun, time.perf_counter() - t0,
+                                                          bpy.app.version_string))
+    if result.skipped:
+        _fail("%d test(s) skipped; a skipped test counts as a failure" % len(result.skipped))
+    if not result.wasSuccessful() or result.testsRun == 0:
+        _fail("%d failure(s), %d error(s)" % (len(result.failures), len(result.errors)))
+    if FAKE:
+        _fail("fake engine used: the plumbing passed, but this is not a valid run")
+    print("run_tests: OK")
+    _exit(0)
+
+
+if __name__ == "__main__":
+    main()

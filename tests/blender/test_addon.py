@@ -1,0 +1,448 @@
+"""Add-on tests inside Blender (run by run_tests.py in Blender 3.4 and bpy 4.2)."""
+
+import hashlib
+import math
+import random
+import struct
+import unittest
+
+import bmesh
+import bpy
+
+import plyio
+
+_CFG = {}
+
+
+def configure(prefix, truth, fake=False):
+    """Called by run_tests.py: the scan files and their ground truth."""
+    vertices, faces = plyio.read_ply(prefix + ".ply")
+    _CFG.update(prefix=prefix, truth=truth, vertices=vertices, faces=faces, fake=fake)
+
+
+def addon():
+    import relief_snake
+    return relief_snake
+
+
+# -- helpers ----------------------------------------------------------------------------
+
+def clear_scene():
+    if bpy.context.object is not None and bpy.context.object.mode != 'OBJECT':
+        bpy.ops.object.mode_set(mode='OBJECT')
+    for ob in list(bpy.data.objects):
+        bpy.data.objects.remove(ob, do_unlink=True)
+    for coll in (bpy.data.meshes, bpy.data.curves):
+        for block in list(coll):
+            coll.remove(block)
+    bpy.context.scene.relief_snake.last_summary = ""
+    bpy.context.scene.relief_snake.last_phases = ""
+
+
+def make_scan_object(name="Scan"):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(_CFG["vertices"], [], _CFG["faces"])
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    return obj
+
+
+def select_vertices(obj, indices, history=True):
+    """Select exactly `indices`; record them as click order (select_history) if asked.
+    Works in Object Mode (via the mesh's stored select history) and Edit Mode."""
+    mesh = obj.data
+    edit = obj.mode == 'EDIT'
+    bm = bmesh.from_edit_mesh(mesh) if edit else bmesh.new()
+    if not edit:
+        bm.from_mesh(mesh)
+    bm.verts.ensure_lookup_table()
+    for e in list(bm.verts) + list(bm.edges) + list(bm.faces):
+        e.select = False
+    bm.select_history.clear()
+    for i in indices:
+        v = bm.verts[i]
+        v.select = True
+        if history:
+            bm.select_history.add(v)
+    if edit:
+        bmesh.update_edit_mesh(mesh)
+    else:
+        bm.to_mesh(mesh)
+        bm.free()
+        mesh.update()
+
+
+def snapshot():
+    """Everything an operator could have changed: objects, meshes' geometry, groups, settings."""
+    h = hashlib.sha1()
+    state = {"objects": sorted((o.name, o.type, o.parent.name if o.parent else None) for o in bpy.data.objects),
+             "curves": sorted(c.name for c in bpy.data.curves)}
+    for ob in bpy.data.objects:
+        if ob.type == 'MESH':
+            if ob.mode == 'EDIT':
+                ob.update_from_editmode()
+            co = [0.0] * (3 * len(ob.data.vertices))
+            ob.data.vertices.foreach_get("co", co)
+            h.update(struct.pack("%dd" % len(co), *co))
+            state[ob.name] = (len(ob.data.vertices), len(ob.data.polygons),
+                              [(g.name, g.index) for g in ob.vertex_groups], ob.vertex_groups.active_index)
+    state["coords"] = h.hexdigest()
+    s = bpy.context.scene.relief_snake
+    state["settings"] = (s.step_height, s.w_int, s.open_contour, s.relief_side, s.group_name, s.make_curve,
+                         s.last_summary, s.last_phases)
+    return state
+
+
+def group_members(obj, name):
+    group = obj.vertex_groups[name]
+    gi = group.index
+    out = set()
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == gi and g.weight > 0:
+                out.add(v.index)
+    return out
+
+
+def iou(a, b):
+    a, b = set(a), set(b)
+    return len(a & b) / max(1, len(a | b))
+
+
+def boundary_points(truth):
+    b = truth["boundary"]
+    if b and isinstance(b[0][0], (list, tuple)):  # several polylines
+        b = [p for line in b for p in line]
+    return b
+
+
+def distances_to(points, targets):
+    """For each point, the distance to the nearest target point (uniform grid hashing)."""
+    cell = max(truth_edge() * 2, 1e-9)
+    grid = {}
+    for t in targets:
+        grid.setdefault(tuple(int(math.floor(c / cell)) for c in t), []).append(t)
+    out = []
+    for p in points:
+        key = tuple(int(math.floor(c / cell)) for c in p)
+        best = math.inf
+        r = 1
+        while best == math.inf and r < 64:
+            for dx in range(-r, r + 1):
+                for dy in range(-r, r + 1):
+                    for dz in range(-r, r + 1):
+                        for t in grid.get((key[0] + dx, key[1] + dy, key[2] + dz), ()):
+                            best = min(best, math.dist(p, t))
+            r *= 2
+        out.append(best)
+    return out
+
+
+def truth_edge():
+    return _CFG["truth"]["average_edge"]
+
+
+def seg(**kw):
+    return bpy.ops.mesh.relief_snake_segment('EXEC_DEFAULT', **kw)
+
+
+# -- tests ------------------------------------------------------------------------------
+
+class AddonTestCase(unittest.TestCase):
+    def setUp(self):
+        clear_scene()
+        self.truth = _CFG["truth"]
+        self.h = float(self.truth["h"])
+        self.picks = list(self.truth["picks"])
+        self.obj = make_scan_object()
+
+    def tearDown(self):
+        clear_scene()
+
+    def assertSegmentationMatchesTruth(self, obj, group="Relief"):
+        members = group_members(obj, group)
+        score = iou(members, self.truth["relief_vertices"])
+        self.assertGreaterEqual(score, 0.9, "IoU %.3f against the ground truth" % score)
+        curve = bpy.data.objects.get(obj.name + "_ReliefContour")
+        self.assertIsNotNone(curve, "no contour curve")
+        self.assertEqual(curve.type, 'CURVE')
+        self.assertIs(curve.parent, obj)
+        self.assertEqual(len(curve.data.splines), 1)
+        spline = curve.data.splines[0]
+        self.assertEqual(spline.type, 'POLY')
+        self.assertTrue(spline.use_cyclic_u)
+        pts = [tuple(p.co)[:3] for p in spline.points]
+        if not _CFG["fake"]:
+            self.assertGreater(len(pts), len(self.picks))  # the snake refines the pick polygon
+        d = sorted(distances_to(pts, boundary_points(self.truth)))
+        median, p90 = d[len(d) // 2], d[int(0.9 * (len(d) - 1))]
+        edge = truth_edge()
+        self.assertLess(median, 2 * edge, "contour median distance to the true boundary %.3g" % median)
+        self.assertLess(p90, max(4 * edge, 0.5 * self.h), "contour p90 distance %.3g" % p90)
+        return members
+
+
+class SegmentOperator(AddonTestCase):
+    def test_registered_with_undo_and_redo(self):
+        cls = bpy.types.MESH_OT_relief_snake_segment
+        self.assertEqual(set(cls.bl_options) & {'REGISTER', 'UNDO'}, {'REGISTER', 'UNDO'})
+        self.assertTrue(hasattr(bpy.types, "VIEW3D_PT_relief_snake"))
+        self.assertTrue(hasattr(bpy.ops.mesh, "relief_snake_measure"))
+
+    def test_object_mode_segments_the_relief(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj)
+        s = bpy.context.scene.relief_snake
+        self.assertIn("snaxels", s.last_summary)
+        self.assertTrue(s.last_phases.strip(), "no phase summary")
+        self.assertEqual(self.obj.vertex_groups.active.name, "Relief")
+        self.assertEqual(self.obj.mode, 'OBJECT')
+
+    def test_scene_settings_feed_the_operator_and_invoke_runs_headless(self):
+        select_vertices(self.obj, self.picks)
+        s = bpy.context.scene.relief_snake
+        s.step_height = self.h
+        s.group_name = "Duck"
+        try:
+            # INVOKE_DEFAULT in background mode must run synchronously, not go modal.
+            self.assertEqual(bpy.ops.mesh.relief_snake_segment('INVOKE_DEFAULT'), {'FINISHED'})
+        finally:
+            s.group_name = "Relief"
+        self.assertIn("Duck", self.obj.vertex_groups)
+        self.assertNotIn("Relief", self.obj.vertex_groups)
+        self.assertSegmentationMatchesTruth(self.obj, "Duck")
+
+    def test_edit_mode_reads_the_unflushed_selection(self):
+        bpy.ops.object.mode_set(mode='EDIT')
+        # Selected only in the edit bmesh: the mesh data still has nothing selected,
+        # so a stale read would fail with "select at least 3 vertices".
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertEqual(self.obj.mode, 'EDIT')
+        bpy.ops.object.mode_set(mode='OBJECT')  # the group must survive leaving Edit Mode
+        self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_edit_mode_geometry_changes_are_seen(self):
+        bpy.ops.object.mode_set(mode='EDIT')
+        bm = bmesh.from_edit_mesh(self.obj.data)
+        bm.verts.ensure_lookup_table()
+        bm.verts[0].co.z += 123.0
+        bmesh.update_edit_mesh(self.obj.data)
+        api = addon().api
+        job = api.prepare(self.obj, self.picks, self.h)
+        self.assertAlmostEqual(job["vertices"][2], _CFG["vertices"][0][2] + 123.0, places=3)
+        bpy.ops.object.mode_set(mode='OBJECT')
+
+    def test_second_run_replaces_group_and_curve(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        first = group_members(self.obj, "Relief")
+        self.obj.vertex_groups.new(name="Other")
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        names = [g.name for g in self.obj.vertex_groups]
+        self.assertEqual(sorted(names), ["Other", "Relief"])
+        self.assertEqual(group_members(self.obj, "Relief"), first)  # deterministic, and not accumulated
+        curves = [o for o in bpy.data.objects if o.type == 'CURVE']
+        self.assertEqual([o.name for o in curves], ["Scan_ReliefContour"])
+        self.assertEqual(len(bpy.data.curves), 1, "orphan curve data left behind")
+
+    def test_no_curve_when_make_curve_is_off(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h, make_curve=False), {'FINISHED'})
+        self.assertIn("Relief", self.obj.vertex_groups)
+        self.assertEqual([o for o in bpy.data.objects if o.type == 'CURVE'], [])
+
+    def test_curve_follows_the_object_transform(self):
+        self.obj.location = (10.0, -5.0, 2.0)
+        self.obj.rotation_euler = (0.3, 0.0, 1.0)
+        bpy.context.view_layer.update()
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        bpy.context.view_layer.update()
+        curve = bpy.data.objects[self.obj.name + "_ReliefContour"]
+        diff = [abs(a - b) for ra, rb in zip(curve.matrix_world, self.obj.matrix_world) for a, b in zip(ra, rb)]
+        self.assertLess(max(diff), 1e-5)
+
+    def test_undo_restores_the_previous_state(self):
+        select_vertices(self.obj, self.picks)
+        before = snapshot()
+        # The first push only initialises the stack in background mode.
+        bpy.ops.ed.undo_push(message="setup")
+        bpy.ops.ed.undo_push(message="before relief snake")
+        # undo=True: push an undo step like a click in the UI does.
+        self.assertEqual(bpy.ops.mesh.relief_snake_segment('EXEC_DEFAULT', True, step_height=self.h),
+                         {'FINISHED'})
+        self.assertIn("Relief", bpy.data.objects["Scan"].vertex_groups)
+        self.assertIn("Scan_ReliefContour", bpy.data.objects)
+        bpy.ops.ed.undo()
+        self.assertEqual(snapshot(), before)
+        self.assertNotIn("Relief", bpy.data.objects["Scan"].vertex_groups)
+        self.assertNotIn("Scan_ReliefContour", bpy.data.objects)
+        bpy.ops.ed.redo()
+        self.assertIn("Relief", bpy.data.objects["Scan"].vertex_groups)
+        self.assertIn("Scan_ReliefContour", bpy.data.objects)
+
+
+class ErrorPaths(AddonTestCase):
+    def assertErrorLeavesSceneUntouched(self, fragment, **kw):
+        before = snapshot()
+        with self.assertRaises(RuntimeError) as ctx:
+            seg(**kw)
+        self.assertIn(fragment.lower(), str(ctx.exception).lower())
+        self.assertEqual(snapshot(), before)
+
+    def test_no_selection(self):
+        select_vertices(self.obj, [])
+        self.assertErrorLeavesSceneUntouched("at least 3", step_height=self.h)
+
+    def test_too_few_picks(self):
+        select_vertices(self.obj, self.picks[:2])
+        self.assertErrorLeavesSceneUntouched("at least 3", step_height=self.h)
+
+    def test_too_few_picks_open(self):
+        select_vertices(self.obj, self.picks[:1])
+        self.assertErrorLeavesSceneUntouched("at least 2", step_height=self.h, open_contour=True)
+
+    def test_bad_step_height(self):
+        select_vertices(self.obj, self.picks)
+        self.assertErrorLeavesSceneUntouched("step height", step_height=0.0)
+
+    def test_non_mesh_active_object(self):
+        select_vertices(self.obj, self.picks)
+        empty = bpy.data.objects.new("Empty", None)
+        bpy.context.scene.collection.objects.link(empty)
+        bpy.context.view_layer.objects.active = empty
+        self.assertErrorLeavesSceneUntouched("mesh object", step_height=self.h)
+
+    def test_no_active_object(self):
+        select_vertices(self.obj, self.picks)
+        bpy.context.view_layer.objects.active = None
+        self.assertErrorLeavesSceneUntouched("mesh object", step_height=self.h)
+
+    def test_empty_group_name(self):
+        select_vertices(self.obj, self.picks)
+        self.assertErrorLeavesSceneUntouched("vertex group a name", step_height=self.h, group_name="  ")
+
+    def test_existing_results_survive_a_failed_run(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertErrorLeavesSceneUntouched("step height", step_height=0.0)
+        self.assertIn("Scan_ReliefContour", bpy.data.objects)
+
+    def test_engine_error_writes_nothing(self):
+        api = addon().api
+        real = api.load_core()
+
+        class Failing:
+            Error, Cancelled = real.Error, real.Cancelled
+
+            @staticmethod
+            def segment(*a, **k):
+                raise real.Error("the snake collapsed: check the step height")
+
+        select_vertices(self.obj, self.picks)
+        api._core = Failing
+        try:
+            self.assertErrorLeavesSceneUntouched("snake collapsed", step_height=self.h)
+        finally:
+            api._core = real
+
+    def test_cancel_from_progress_writes_nothing(self):
+        api = addon().api
+        core = api.load_core()
+        calls = []
+
+        def progress(phase, iteration, snaxels, contour):
+            calls.append((phase, iteration, snaxels, len(contour)))
+            return len(calls) < 3
+
+        before = snapshot()
+        with self.assertRaises(core.Cancelled):
+            api.segment_object(self.obj, self.picks, self.h, progress=progress)
+        self.assertEqual(len(calls), 3)
+        self.assertGreater(calls[0][3], 0, "progress got an empty contour")
+        self.assertEqual(snapshot(), before)
+
+
+class PickOrder(AddonTestCase):
+    def test_click_order_is_used(self):
+        order = self.picks[::-1]
+        select_vertices(self.obj, order)
+        picks, info = addon().api.selected_picks(self.obj)
+        self.assertEqual(picks, order)
+        self.assertIsNone(info)
+
+    def test_missing_click_order_falls_back_to_angle(self):
+        shuffled = self.picks[:]
+        random.Random(3).shuffle(shuffled)
+        select_vertices(self.obj, shuffled, history=False)
+        picks, info = addon().api.selected_picks(self.obj)
+        self.assertIn("angle", info)
+        self.assertEqual(sorted(picks), sorted(self.picks))
+        # The truth's picks are a ring around the relief: the fallback recovers it up to
+        # start and direction.
+        k = picks.index(self.picks[0])
+        rot = picks[k:] + picks[:k]
+        self.assertIn(rot, (self.picks, [self.picks[0]] + self.picks[:0:-1]))
+        # ...and the operator still segments correctly from it.
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_partial_click_order_falls_back(self):
+        select_vertices(self.obj, self.picks)
+        bm = bmesh.new()
+        bm.from_mesh(self.obj.data)
+        bm.verts.ensure_lookup_table()
+        bm.select_history.clear()
+        for i in self.picks[:2]:
+            bm.select_history.add(bm.verts[i])
+        bm.to_mesh(self.obj.data)
+        bm.free()
+        picks, info = addon().api.selected_picks(self.obj)
+        self.assertIn("2 of %d" % len(self.picks), info)
+
+
+class MeasureAndApi(AddonTestCase):
+    def test_measure_sets_the_step_height(self):
+        a, b = self.picks[0], self.truth["relief_vertices"][0]
+        select_vertices(self.obj, [a, b])
+        self.assertEqual(bpy.ops.mesh.relief_snake_measure(), {'FINISHED'})
+        expected = math.dist(_CFG["vertices"][a], _CFG["vertices"][b])
+        self.assertAlmostEqual(bpy.context.scene.relief_snake.step_height, expected, places=4)
+        self.assertAlmostEqual(addon().api.measure(self.obj, a, b), expected, places=4)
+
+    def test_measure_needs_two_vertices(self):
+        select_vertices(self.obj, self.picks[:3])
+        before = snapshot()
+        with self.assertRaises(RuntimeError) as ctx:
+            bpy.ops.mesh.relief_snake_measure()
+        self.assertIn("exactly two", str(ctx.exception))
+        self.assertEqual(snapshot(), before)
+
+    def test_api_segment_without_writing(self):
+        before = snapshot()
+        result = addon().api.segment_object(self.obj, self.picks, self.h, write=False)
+        self.assertEqual(snapshot(), before)
+        self.assertGreaterEqual(iou(result["relief_vertices"], self.truth["relief_vertices"]), 0.9)
+        self.assertTrue(result["closed"])
+        for key in ("read", "engine", "write"):
+            self.assertIn(key, result["timing"])
+        self.assertTrue(result["phases"])
+
+    def test_api_rejects_bad_picks(self):
+        api = addon().api
+        with self.assertRaises(api.EngineError) as ctx:
+            api.segment_object(self.obj, [0, 1, 10 ** 9], self.h)
+        self.assertIn("not a vertex", str(ctx.exception))
+
+    def test_preview_makes_no_shader_in_background(self):
+        preview = addon().preview
+        self.assertEqual(preview.builtin_shader_name((3, 4, 1)), '3D_UNIFORM_COLOR')
+        self.assertEqual(preview.builtin_shader_name((4, 2, 0)), 'UNIFORM_COLOR')
+        preview.start()
+        self.assertFalse(preview.is_active())
+        self.assertIsNone(preview._shader)

@@ -1,0 +1,104 @@
+// The snake's housekeeping: resampling keeps the spacing, sharp turns go,
+// open ends slide along the boundary, inward points inside.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "relief_snake/snake.hpp"
+#include "test_meshes.hpp"
+
+using namespace relief_snake;
+
+namespace {
+
+SurfacePoint point_at(const Mesh& mesh, const Vec3& target) {
+  // Walk from the nearest vertex to the exact point (plane meshes only).
+  int best = 0;
+  for (int v = 1; v < mesh.n_vertices(); ++v)
+    if ((mesh.position(v) - target).norm() < (mesh.position(best) - target).norm()) best = v;
+  const SurfacePoint start = vertex_point(mesh, best);
+  const Vec3 d = target - mesh.position(best);
+  return d.norm() > 0 ? walk(mesh, start, d, d.norm()).end : start;
+}
+
+std::vector<SurfacePoint> circle(const Mesh& mesh, Vec3 c, double r, int n, bool ccw = true) {
+  std::vector<SurfacePoint> pts;
+  for (int k = 0; k < n; ++k) {
+    const double a = (ccw ? 1 : -1) * 2 * M_PI * k / n;
+    pts.push_back(point_at(mesh, c + r * Vec3(std::cos(a), std::sin(a), 0)));
+  }
+  return pts;
+}
+
+}  // namespace
+
+TEST(Snake, ResampleKeepsSpacingWithinHalfToOneAndAHalfL) {
+  const Mesh mesh = test::plane_mesh(61, 20);
+  // Uneven circle: 12 points, then move a few close together.
+  std::vector<SurfacePoint> pts = circle(mesh, Vec3(10, 10, 0), 6, 12);
+  pts.insert(pts.begin() + 3, point_at(mesh, position(mesh, pts[3]) + Vec3(0.05, 0.05, 0)));
+  Snake snake(mesh, pts, true, true);
+  const double l = 1.0;
+  snake.resample(l);
+  ASSERT_GE(snake.size(), 30);
+  for (int i = 0; i < snake.size(); ++i) {
+    const double d = (snake[snake.next(i)].position - snake[i].position).norm();
+    EXPECT_GE(d, 0.5 * l - 1e-9) << "segment " << i;
+    EXPECT_LE(d, 1.5 * l + 1e-9) << "segment " << i;
+  }
+  // Points stay on the circle's neighbourhood (inserted on chords).
+  for (int i = 0; i < snake.size(); ++i) EXPECT_NEAR((snake[i].position - Vec3(10, 10, 0)).norm(), 6, 0.4);
+}
+
+TEST(Snake, InwardPointsToTheCentreForEitherOrientation) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  for (bool ccw : {true, false}) {
+    Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 24, ccw), true, /*inside_left=*/ccw);
+    for (int i = 0; i < snake.size(); ++i) {
+      const Vec3 to_centre = (Vec3(10, 10, 0) - snake[i].position).normalized();
+      EXPECT_GT(snake.inward(i).dot(to_centre), 0.99);
+    }
+  }
+}
+
+TEST(Snake, SharpTurnsAreRemoved) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  std::vector<SurfacePoint> pts = circle(mesh, Vec3(10, 10, 0), 5, 16);
+  Snake snake(mesh, pts, true, true);
+  // Fold a snaxel back onto its predecessor to make a turn of ~170 degrees.
+  snake.move(5, point_at(mesh, snake[4].position + 0.98 * (snake[3].position - snake[4].position) +
+                                   Vec3(0.05, 0, 0)));
+  ASSERT_GT(snake.turn_degrees(4), 160);
+  const int before = snake.size();
+  EXPECT_GE(snake.remove_sharp_turns(160), 1);
+  EXPECT_LT(snake.size(), before);
+  for (int i = 0; i < snake.size(); ++i) EXPECT_LE(snake.turn_degrees(i), 160);
+}
+
+TEST(Snake, OpenEndsSlideAlongTheBoundary) {
+  const Mesh mesh = test::plane_mesh(21, 10);
+  const SurfacePoint end = point_at(mesh, Vec3(0, 5, 0));  // on the left border x = 0
+  int f, k;
+  ASSERT_TRUE(boundary_edge_of(mesh, end, &f, &k));
+  const Vec3 a = position(mesh, slide_along_boundary(mesh, end, 1.3));
+  const Vec3 b = position(mesh, slide_along_boundary(mesh, end, -1.3));
+  EXPECT_NEAR(a.x(), 0, 1e-9);
+  EXPECT_NEAR(b.x(), 0, 1e-9);
+  EXPECT_NEAR(std::abs(a.y() - 5), 1.3, 1e-9);
+  EXPECT_NEAR(std::abs(b.y() - 5), 1.3, 1e-9);
+  EXPECT_NEAR(a.y() + b.y(), 10, 1e-9);  // opposite directions
+  // Sliding around a corner continues on the next side.
+  const Vec3 c = position(mesh, slide_along_boundary(mesh, point_at(mesh, Vec3(0, 1, 0)), a.y() > 5 ? -3.0 : 3.0));
+  EXPECT_NEAR(c.y(), 0, 1e-9);
+  EXPECT_NEAR(c.x(), 2, 1e-9);
+}
+
+TEST(Snake, SubdivideReachesTheRequestedSpacing) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 10), true, true);
+  snake.subdivide(0.25);
+  const double expected = snake.length() / snake.size();
+  EXPECT_NEAR(expected, 0.25, 0.05);
+  for (int i = 0; i < snake.size(); ++i)
+    EXPECT_NEAR((snake[snake.next(i)].position - snake[i].position).norm(), expected, 0.1);
+}

@@ -1,0 +1,110 @@
+// SurfacePoint and straight walks on the surface.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "relief_snake/surface_point.hpp"
+#include "test_meshes.hpp"
+
+using namespace relief_snake;
+
+namespace {
+
+SurfacePoint point_near(const Mesh& mesh, const Vec3& target) {
+  int best = 0;
+  for (int v = 1; v < mesh.n_vertices(); ++v)
+    if ((mesh.position(v) - target).norm() < (mesh.position(best) - target).norm()) best = v;
+  return vertex_point(mesh, best);
+}
+
+}  // namespace
+
+TEST(SurfacePoint, VertexPointAndPosition) {
+  const Mesh mesh = test::plane_mesh(11, 10);
+  for (int v : {0, 5, 60, 120}) {
+    const SurfacePoint p = vertex_point(mesh, v);
+    ASSERT_TRUE(p.valid());
+    EXPECT_NEAR((position(mesh, p) - mesh.position(v)).norm(), 0, 1e-12);
+    EXPECT_EQ(nearest_corner(mesh, p), v);
+  }
+}
+
+TEST(SurfacePoint, WalkOnPlaneIsStraightAndExact) {
+  const Mesh mesh = test::plane_mesh(21, 10);
+  const SurfacePoint start = point_near(mesh, Vec3(2, 2, 0));
+  const Vec3 dir = Vec3(1, 0.7, 0).normalized();
+  const Walk w = walk(mesh, start, dir, 5.0);
+  EXPECT_FALSE(w.hit_boundary);
+  EXPECT_NEAR(w.travelled, 5.0, 1e-9);
+  EXPECT_NEAR((position(mesh, w.end) - (Vec3(2, 2, 0) + 5.0 * dir)).norm(), 0, 1e-9);
+  EXPECT_GE(w.end.bary.minCoeff(), 0);
+  EXPECT_NEAR(w.end.bary.sum(), 1, 1e-12);
+}
+
+TEST(SurfacePoint, WalkThroughVerticesAlongDiagonal) {
+  // Along the grid diagonal the path passes exactly through vertices.
+  const Mesh mesh = test::plane_mesh(21, 10);
+  const SurfacePoint start = point_near(mesh, Vec3(1, 1, 0));
+  const Walk w = walk(mesh, start, Vec3(1, 1, 0), 6.0);
+  EXPECT_NEAR(w.travelled, 6.0, 1e-9);
+  EXPECT_NEAR((position(mesh, w.end) - Vec3(1 + 6 / std::sqrt(2.0), 1 + 6 / std::sqrt(2.0), 0)).norm(), 0, 1e-6);
+}
+
+TEST(SurfacePoint, WalkStopsAtBoundary) {
+  const Mesh mesh = test::plane_mesh(11, 10);
+  const SurfacePoint start = point_near(mesh, Vec3(5, 5, 0));
+  const Walk w = walk(mesh, start, Vec3(1, 0, 0), 20.0);
+  EXPECT_TRUE(w.hit_boundary);
+  EXPECT_NEAR(w.travelled, 5.0, 1e-9);
+  EXPECT_NEAR(position(mesh, w.end).x(), 10.0, 1e-9);
+}
+
+TEST(SurfacePoint, WalkAcrossEdgesOnCylinderFollowsTheCircle) {
+  // Walking around a cylinder (perpendicular to its axis) must stay on the
+  // circle of radius r: the unfolding keeps the geodesic on the surface.
+  const double r = 3;
+  const Mesh mesh = test::cylinder_mesh(r, 121, 11, 4.0, 2 * r * 1.5);
+  const SurfacePoint start = point_near(mesh, Vec3(r * std::sin(1.0 / r), 2.0, r * std::cos(1.0 / r)));
+  const double arc = 6.0;
+  std::vector<double> distances;
+  for (int k = 1; k <= 12; ++k) distances.push_back(arc * k / 12);
+  std::vector<SurfacePoint> samples;
+  const Walk w = walk_sampled(mesh, start, Vec3(1, 0, 0), distances, &samples);
+  ASSERT_EQ(samples.size(), distances.size());
+  EXPECT_FALSE(w.hit_boundary);
+  for (const SurfacePoint& s : samples) {
+    const Vec3 p = position(mesh, s);
+    EXPECT_NEAR(p.y(), 2.0, 1e-6);                        // no drift along the axis
+    EXPECT_NEAR(std::hypot(p.x(), p.z()), r, 2e-3 * r);  // on the (polygonal) cylinder
+  }
+  // The arc angle covered matches the distance (chordal polygon: within 1%).
+  const Vec3 a = position(mesh, start), b = position(mesh, w.end);
+  const double angle = std::atan2(b.x(), b.z()) - std::atan2(a.x(), a.z());
+  EXPECT_NEAR(angle * r, arc, 0.01 * arc);
+}
+
+TEST(SurfacePoint, InFaceAndCommonFace) {
+  const Mesh mesh = test::plane_mesh(11, 10);
+  const int v = 60;
+  const SurfacePoint a = vertex_point(mesh, v);
+  for (const int* f = mesh.faces_begin(v); f != mesh.faces_end(v); ++f) {
+    Vec3 b;
+    ASSERT_TRUE(in_face(mesh, a, *f, &b));
+    EXPECT_NEAR((position(mesh, SurfacePoint{*f, b}) - mesh.position(v)).norm(), 0, 1e-12);
+  }
+  const SurfacePoint far = vertex_point(mesh, 0);
+  int face;
+  Vec3 ba, bb;
+  EXPECT_FALSE(common_face(mesh, a, far, &face, &ba, &bb));
+  const SurfacePoint neighbour = vertex_point(mesh, *mesh.neighbors_begin(v));
+  ASSERT_TRUE(common_face(mesh, a, neighbour, &face, &ba, &bb));
+  EXPECT_NEAR((position(mesh, SurfacePoint{face, ba}) - mesh.position(v)).norm(), 0, 1e-12);
+}
+
+TEST(SurfacePoint, InterpolateIsLinear) {
+  const Mesh mesh = test::plane_mesh(11, 10);
+  SurfacePoint p{10, Vec3(0.2, 0.3, 0.5)};
+  const Vec3 x = position(mesh, p);
+  const double value = interpolate(mesh, p, [&](int v) { return 2 * mesh.position(v).x() - mesh.position(v).y(); });
+  EXPECT_NEAR(value, 2 * x.x() - x.y(), 1e-12);
+}

@@ -1,0 +1,185 @@
+// make-scan: writes a synthetic scan (PLY or OBJ) and its ground truth (JSON), or scores a
+// segmentation result against a truth file. Run `make-scan --help`.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "relief_snake/error.hpp"
+#include "synthetic.hpp"
+
+namespace rs = relief_snake;
+namespace syn = relief_snake::synthetic;
+
+namespace {
+
+const char* kUsage =
+    "usage:\n"
+    "  make-scan [options] --out PREFIX        writes PREFIX.ply (or .obj) and PREFIX.truth.json\n"
+    "  make-scan score TRUTH.json RESULT.json  prints {iou, mean/p95/max distances both ways, in average edges}\n"
+    "options (defaults in brackets):\n"
+    "  --shape duck|disk|rectangle|slots|open [duck]    --background plane|cylinder|sphere|saddle [plane]\n"
+    "  --triangles N [100000]   --h H [1]   --seed K [1]   --radius R [40]   --width W [80]   --height H [56]\n"
+    "  --step sharp|blended [sharp]   --blend-width B [0.5, in h]   --detail A [0, fraction of h]   --drop\n"
+    "  --noise S [0, sigma as a fraction of h]   --jitter J [0.3]\n"
+    "  --slots W1,W2,.. [3,5,8,12, mouth widths in average edges]   --slot-depth D [5, in h]\n"
+    "  --start near|far|zigzag [near]   --picks N [8]   --distance D [3, in h]   --far-distance D [auto, in h]\n"
+    "  --reverse (reverse the pick order)   --format ply|obj [ply]\n"
+    "RESULT.json needs \"polyline\" (or \"contour\") as [[x,y,z],...] and \"relief_vertices\"; \"closed\" is optional.\n";
+
+std::vector<double> parse_list(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) out.push_back(std::stod(item));
+  return out;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw rs::Error("cannot read " + path + ": check the path");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw rs::Error(path + " is not valid JSON: " + e.what());
+  }
+}
+
+std::vector<rs::Vec3> points_of(const nlohmann::json& list) {
+  std::vector<rs::Vec3> out;
+  for (const auto& p : list) {
+    if (!p.is_array() || p.size() != 3) throw rs::Error("expected a list of [x, y, z] points");
+    out.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  }
+  return out;
+}
+
+int run_score(const std::string& truth_path, const std::string& result_path) {
+  const nlohmann::json truth = read_json(truth_path), result = read_json(result_path);
+  std::vector<syn::Polyline> boundary;
+  const auto& b = truth.at("boundary");
+  // boundary: a list of polylines (or, accepted too, one polyline as a list of points)
+  const bool nested = !b.empty() && b[0].is_array() && !b[0].empty() && b[0][0].is_array();
+  if (nested) {
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      syn::Polyline p;
+      p.points = points_of(b[i]);
+      p.closed = truth.contains("boundary_closed") ? truth["boundary_closed"][i].get<bool>() : !truth.value("open", false);
+      boundary.push_back(std::move(p));
+    }
+  } else {
+    boundary.push_back({points_of(b), !truth.value("open", false)});
+  }
+  syn::Polyline contour;
+  if (result.contains("polyline")) contour.points = points_of(result["polyline"]);
+  else if (result.contains("contour")) contour.points = points_of(result["contour"]);
+  else throw rs::Error(result_path + " has no \"polyline\" (list of [x, y, z]): pass a segmentation result");
+  contour.closed = result.value("closed", !truth.value("open", false));
+  const std::vector<std::int64_t> relief = result.value("relief_vertices", std::vector<std::int64_t>{});
+  const syn::Score s = syn::score(contour, relief, boundary, truth.at("relief_vertices").get<std::vector<std::int64_t>>(),
+                                  truth.at("average_edge").get<double>());
+  nlohmann::json out = {{"iou", s.iou},
+                        {"result_vertices", s.result_vertices},
+                        {"truth_vertices", s.truth_vertices},
+                        {"common_vertices", s.common_vertices},
+                        {"mean_to_truth", s.mean_to_truth},
+                        {"p95_to_truth", s.p95_to_truth},
+                        {"max_to_truth", s.max_to_truth},
+                        {"mean_from_truth", s.mean_from_truth},
+                        {"p95_from_truth", s.p95_from_truth},
+                        {"max_from_truth", s.max_from_truth},
+                        {"units", "average edges"}};
+  std::cout << out.dump(2) << std::endl;
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::cout << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] == "score") {
+    if (args.size() != 3) throw rs::Error("score needs two files: make-scan score TRUTH.json RESULT.json");
+    return run_score(args[1], args[2]);
+  }
+  syn::ScanSpec spec;
+  syn::PickSpec picks;
+  std::string out, format = "ply";
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw rs::Error(a + " needs a value (see make-scan --help)");
+      return args[++i];
+    };
+    try {
+      if (a == "--shape") spec.shape = syn::parse_shape(value());
+      else if (a == "--background") spec.background = syn::parse_background(value());
+      else if (a == "--triangles") spec.triangles = std::stoull(value());
+      else if (a == "--step") spec.step = syn::parse_step(value());
+      else if (a == "--blend-width") spec.blend_width = std::stod(value());
+      else if (a == "--detail") spec.detail = std::stod(value());
+      else if (a == "--drop") spec.drop = true;
+      else if (a == "--noise") spec.noise = std::stod(value());
+      else if (a == "--jitter") spec.jitter = std::stod(value());
+      else if (a == "--h") spec.h = std::stod(value());
+      else if (a == "--seed") spec.seed = std::stoull(value());
+      else if (a == "--radius") spec.radius = std::stod(value());
+      else if (a == "--width") spec.width = std::stod(value());
+      else if (a == "--height") spec.height = std::stod(value());
+      else if (a == "--slots") spec.slot_widths = parse_list(value());
+      else if (a == "--slot-depth") spec.slot_depth = std::stod(value());
+      else if (a == "--start") picks.start = syn::parse_start(value());
+      else if (a == "--picks") picks.count = std::stoi(value());
+      else if (a == "--distance") picks.distance = std::stod(value());
+      else if (a == "--far-distance") picks.far_distance = std::stod(value());
+      else if (a == "--reverse") picks.reverse = true;
+      else if (a == "--format") format = value();
+      else if (a == "--out") out = value();
+      else throw rs::Error("unknown option " + a + " (see make-scan --help)");
+    } catch (const std::logic_error& e) {  // std::stod and friends
+      throw rs::Error("bad value for " + a + ": give a number (see make-scan --help)");
+    }
+  }
+  if (out.empty()) throw rs::Error("--out PREFIX is required (writes PREFIX.ply and PREFIX.truth.json)");
+  if (format != "ply" && format != "obj") throw rs::Error("--format must be ply or obj");
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const syn::Scan scan = syn::generate(spec);
+  const auto t1 = std::chrono::steady_clock::now();
+  const syn::Picks p = scan.picks(picks);
+  const std::string mesh_path = out + "." + format, truth_path = out + ".truth.json";
+  if (format == "ply") syn::write_ply(scan, mesh_path);
+  else syn::write_obj(scan, mesh_path);
+  syn::write_truth_json(scan, p, truth_path);
+  const auto t2 = std::chrono::steady_clock::now();
+  nlohmann::json summary = {{"mesh", mesh_path},
+                            {"truth", truth_path},
+                            {"triangles", scan.n_faces()},
+                            {"vertices", scan.n_vertices()},
+                            {"average_edge", scan.average_edge},
+                            {"h", scan.h},
+                            {"relief_fraction", scan.relief_fraction()},
+                            {"picks", p.vertices.size()},
+                            {"generate_seconds", std::chrono::duration<double>(t1 - t0).count()},
+                            {"total_seconds", std::chrono::duration<double>(t2 - t0).count()}};
+  std::cout << summary.dump() << std::endl;
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "make-scan: " << e.what() << std::endl;
+    return 1;
+  }
+}
