@@ -56,9 +56,11 @@ double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
     }
   }
   const double px = planarity_.filtered(x);
-  if (!(px > q_value)) return 0;
   const double d = px - q_value;
-  return d * d;
+  if (d > 0) return d * d;
+  // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
+  // is penalised instead of ignored, so it cannot slip past the step's top edge.
+  return convex_barrier_ ? -d * d : 0.0;
 }
 
 }  // namespace relief_snake

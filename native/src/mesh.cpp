@@ -253,7 +253,7 @@ Mesh Mesh::from_polygons(std::vector<Vec3> V, const std::vector<std::int64_t>& c
     for (std::size_t i = 0; i < nv; ++i)
       if (mesh_id[i] == 0) mesh_id[i] = next++;
     mesh.om_ = TriMesh();
-    mesh.om_.reserve(static_cast<size_t>(next), 3 * ncand / 2 + 3, ncand);
+    mesh.om_.reserve(static_cast<size_t>(next), 3 * ncand / 2 + static_cast<size_t>(next) / 8 + 16, ncand);
     for (std::size_t i = 0; i < nv; ++i)
       if (mesh_id[i] >= 0) mesh.om_.add_vertex(TriMesh::Point(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]));
     StreamSilencer quiet(::omerr());  // OpenMesh reports refused faces on omerr; we count them instead

@@ -204,6 +204,10 @@ void PlanarityField::geodesic_ball(int v, std::vector<int>* vertices, std::vecto
 
 double PlanarityField::compute_raw(int v) {
   march(v);
+  if (options_.include_one_ring) {
+    for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
+      if (!accepted_[*it]) ball_.push_back(*it);  // beyond h, but adjacent
+  }
   reset_scratch();
   // ball_[0] is v itself; the neighbours are the rest.
   const int* begin = ball_.data() + 1;

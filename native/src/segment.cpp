@@ -181,6 +181,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
 
   Snake snake(mesh, start, options.closed, inside_left);
   FeatureEnergy feature(planarity, h, options.epsilon, options.q_samples);
+  feature.set_convex_barrier(options.convex_barrier);
 
   PhaseSettings base;
   base.tau = options.tau;
@@ -188,6 +189,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   base.lock_interval = options.lock_interval;
   base.max_iterations = options.max_iterations;
   base.min_snaxels = options.closed ? 4 : 2;
+  base.remove_loops = options.remove_loops;
 
   PhaseSettings coarse = base;
   coarse.name = "coarse";

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace relief_snake {
 
@@ -259,6 +260,95 @@ int Snake::resample(double l) {
     ++changes;
   }
   return changes;
+}
+
+namespace {
+
+// Do segments p0p1 and q0q1 cross, seen along the normal n?
+bool segments_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, const Vec3& n) {
+  Vec3 e1 = (p1 - p0);
+  e1 -= e1.dot(n) * n;
+  if (e1.squaredNorm() <= 0) return false;
+  e1.normalize();
+  const Vec3 e2 = n.cross(e1);
+  auto flat = [&](const Vec3& x) { return Eigen::Vector2d((x - p0).dot(e1), (x - p0).dot(e2)); };
+  const Eigen::Vector2d a = flat(p0), b = flat(p1), c = flat(q0), d = flat(q1);
+  auto orient = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v, const Eigen::Vector2d& w) {
+    return (v.x() - u.x()) * (w.y() - u.y()) - (v.y() - u.y()) * (w.x() - u.x());
+  };
+  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  return ((o1 > 0) != (o2 > 0)) && ((o3 > 0) != (o4 > 0)) && o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0;
+}
+
+}  // namespace
+
+int Snake::remove_loops() {
+  int removed = 0;
+  for (int pass = 0; pass < 64; ++pass) {
+    const int n = size();
+    const int segments = closed_ ? n : n - 1;
+    if (segments < 4) break;
+    // Uniform grid over segment bounding boxes; cell = longest segment.
+    double cell = 0;
+    for (int i = 0; i < segments; ++i)
+      cell = std::max(cell, (snaxels_[next(i)].position - snaxels_[i].position).norm());
+    if (!(cell > 0)) break;
+    struct Key {
+      long x, y, z;
+      bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+    };
+    struct KeyHash {
+      std::size_t operator()(const Key& k) const {
+        return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L);
+      }
+    };
+    std::unordered_map<Key, std::vector<int>, KeyHash> grid;
+    auto key_of = [&](const Vec3& p) {
+      return Key{static_cast<long>(std::floor(p.x() / cell)), static_cast<long>(std::floor(p.y() / cell)),
+                 static_cast<long>(std::floor(p.z() / cell))};
+    };
+    for (int i = 0; i < segments; ++i) {
+      const Vec3 mid = 0.5 * (snaxels_[i].position + snaxels_[next(i)].position);
+      grid[key_of(mid)].push_back(i);
+    }
+    int cut_a = -1, cut_b = -1;
+    for (int i = 0; i < segments && cut_a < 0; ++i) {
+      const Vec3& p0 = snaxels_[i].position;
+      const Vec3& p1 = snaxels_[next(i)].position;
+      const Key k = key_of(0.5 * (p0 + p1));
+      for (long dx = -1; dx <= 1 && cut_a < 0; ++dx)
+        for (long dy = -1; dy <= 1 && cut_a < 0; ++dy)
+          for (long dz = -1; dz <= 1 && cut_a < 0; ++dz) {
+            auto it = grid.find(Key{k.x + dx, k.y + dy, k.z + dz});
+            if (it == grid.end()) continue;
+            for (int j : it->second) {
+              if (j <= i + 1 || (closed_ && i == 0 && j == segments - 1)) continue;
+              const Vec3 nrm = normal(mesh_, snaxels_[i].point);
+              if (segments_cross(p0, p1, snaxels_[j].position, snaxels_[next(j)].position, nrm)) {
+                cut_a = i;
+                cut_b = j;
+                break;
+              }
+            }
+          }
+    }
+    if (cut_a < 0) break;
+    // Segments a and b cross: the loop is snaxels a+1 .. b (inner arc) or the
+    // rest (outer arc). Keep the longer arc; open snakes keep their ends.
+    const int inner = cut_b - cut_a;
+    const int outer = n - inner;
+    std::vector<Snaxel> kept;
+    if (!closed_ || inner <= outer) {
+      for (int i = 0; i <= cut_a; ++i) kept.push_back(snaxels_[i]);
+      for (int i = cut_b + 1; i < n; ++i) kept.push_back(snaxels_[i]);
+    } else {
+      for (int i = cut_a + 1; i <= cut_b; ++i) kept.push_back(snaxels_[i]);
+    }
+    removed += n - static_cast<int>(kept.size());
+    snaxels_.swap(kept);
+    for (Snaxel& s : snaxels_) s.moved = true;
+  }
+  return removed;
 }
 
 void Snake::subdivide(double l) {

@@ -30,12 +30,15 @@ class FeatureEnergy {
   double unscaled(const SurfacePoint& x, const Vec3& inward);
   /// The q found by the last unscaled() call (for tests and drawing).
   const SurfacePoint& last_q() const { return last_q_; }
+  /// Also penalise P^(x) < P^(q) (returns -(P^(x) - P^(q))^2 there). Not in the paper.
+  void set_convex_barrier(bool on) { convex_barrier_ = on; }
 
  private:
   PlanarityField& planarity_;
   std::vector<double> distances_;
   std::vector<SurfacePoint> samples_;
   SurfacePoint last_q_;
+  bool convex_barrier_ = false;
 };
 
 }  // namespace relief_snake

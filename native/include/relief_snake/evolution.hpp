@@ -21,6 +21,7 @@ struct PhaseSettings {
   double max_turn_degrees = 160;
   int lock_interval = 10;
   int max_iterations = 3000;
+  bool remove_loops = true;   ///< cut off self-intersection loops (not in the paper)
   int min_snaxels = 4;        ///< fewer means the snake collapsed
 };
 

@@ -13,6 +13,10 @@ namespace relief_snake {
 struct PlanarityOptions {
   double radius = 0;          ///< geodesic neighbourhood radius: the step height h
   double sigma_s = 0;         ///< bilateral similarity sigma; <= 0: estimate (see PlanarityField::estimate_sigma_s)
+  /// Always count the one-ring among the neighbours, even beyond distance h: a
+  /// scanned vertical step of height ~h has no vertices on its wall, so the ball
+  /// alone would never see the top from the foot (not in the paper).
+  bool include_one_ring = true;
 };
 
 /// Planarity P(v) and filtered planarity P^(v) of a mesh for one radius h.

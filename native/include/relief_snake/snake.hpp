@@ -49,6 +49,10 @@ class Snake {
   /// Splits segments longer than 1.5 l and merges those shorter than 0.5 l;
   /// returns the number of snaxels added plus removed.
   int resample(double l);
+  /// Cuts off loops where the snake crosses itself (the shorter side of each
+  /// crossing goes); returns the number of snaxels removed. Not in the paper:
+  /// see Options::remove_loops.
+  int remove_loops();
   /// Resamples every segment to spacing ~l by walking between consecutive snaxels
   /// (used when the refinement phase starts with a shorter l).
   void subdivide(double l);
