@@ -368,7 +368,7 @@ class PyMesh {
     segmenter_ = std::make_unique<Segmenter>(*mesh_);
   }
 
-  py::dict segment(py::handle picks, double step_height, double w_int, bool open_contour,
+  py::dict segment(py::object picks, double step_height, double w_int, bool open_contour,
                    const std::string& relief_side, int max_iterations, py::object progress) {
     return run_segmentation(*segmenter_, *mesh_, &lock_, picks, step_height, w_int, open_contour, relief_side,
                             max_iterations, std::move(progress), 0.0);
@@ -421,7 +421,7 @@ PYBIND11_MODULE(relief_snake_core, m) {
 
   m.def(
       "segment",
-      [](py::handle vertices, py::handle triangles, py::handle picks, double step_height, double w_int,
+      [](py::object vertices, py::object triangles, py::object picks, double step_height, double w_int,
          bool open_contour, const std::string& relief_side, int max_iterations, py::object progress) {
         // Options are checked before the (possibly long) mesh construction.
         make_options(step_height, w_int, open_contour, relief_side, max_iterations);
@@ -441,19 +441,21 @@ PYBIND11_MODULE(relief_snake_core, m) {
       py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
       py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), segment_doc);
 
-  m.def("measure", &measure_vertices, py::arg("vertices"), py::arg("i"), py::arg("j"),
+  m.def("measure", [](py::object vertices, std::int64_t i, std::int64_t j) { return measure_vertices(vertices, i, j); },
+        py::arg("vertices"), py::arg("i"), py::arg("j"),
         "measure(vertices, i, j) -> float: Euclidean distance between vertices i and j (to estimate h).");
 
   m.def(
       "mesh_report",
-      [](py::handle vertices, py::handle triangles) { return build_mesh(vertices, triangles)->report().summary(); },
+      [](py::object vertices, py::object triangles) { return build_mesh(vertices, triangles)->report().summary(); },
       py::arg("vertices"), py::arg("triangles"),
       "mesh_report(vertices, triangles) -> str: one-line summary of what mesh intake kept, merged or refused.");
 
   py::class_<PyMesh>(m, "Mesh",
                      "A validated mesh that keeps its planarity cache between segmentations "
                      "(segmenting a second relief with the same h costs only the snake).")
-      .def(py::init<py::handle, py::handle>(), py::arg("vertices"), py::arg("triangles"))
+      .def(py::init([](py::object vertices, py::object triangles) { return std::make_unique<PyMesh>(vertices, triangles); }),
+           py::arg("vertices"), py::arg("triangles"))
       .def_property_readonly("report", [](const PyMesh& self) { return self.mesh().report().summary(); })
       .def_property_readonly("n_vertices", [](const PyMesh& self) { return self.mesh().n_vertices(); })
       .def_property_readonly("n_faces", [](const PyMesh& self) { return self.mesh().n_faces(); })

@@ -23,6 +23,8 @@ BUILD = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build"))
 
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+    transfer_only = "--transfer-only" in argv  # skip the engine (e.g. while it is unfinished)
+    argv = [a for a in argv if a != "--transfer-only"]
     triangles = int(argv[0]) if argv else 300000
     sys.path[:0] = [BUILD, os.path.join(ROOT, "addon"), HERE]
     import addon_utils
@@ -45,6 +47,28 @@ def main():
     bpy.context.view_layer.objects.active = obj
     select_vertices(obj, truth["picks"])
 
+    want = set(truth["relief_vertices"])
+    got = want
+    if transfer_only:
+        print("bench: Blender %s, %d vertices, %d faces (transfer only, no engine run)"
+              % (bpy.app.version_string, len(mesh.vertices), len(mesh.polygons)))
+    else:
+        got = _run_operator(obj, truth, mesh)
+    api, mesh_io = mod.api, mod.mesh_io
+    contour = [tuple(p) for line in truth["boundary"] for p in line] if isinstance(truth["boundary"][0][0], list) \
+        else [tuple(p) for p in truth["boundary"]]
+    for name, fn in (("selection + click order", lambda: api.selected_picks(obj)),
+                     ("foreach_get vertices + loop triangles", lambda: mesh_io.read_buffers(obj.data)),
+                     ("vertex group write (%d vertices)" % len(got),
+                      lambda: mesh_io.write_vertex_group(obj, "Relief", sorted(got))),
+                     ("curve write (%d points)" % len(contour), lambda: mesh_io.write_curve(obj, contour, True))):
+        best = min(_timed(fn) for _ in range(3))
+        print("bench:   %-40s %.3f s" % (name, best))
+    sys.stdout.flush()
+    os._exit(0)
+
+
+def _run_operator(obj, truth, mesh):
     t0 = time.perf_counter()
     ret = bpy.ops.mesh.relief_snake_segment('EXEC_DEFAULT', step_height=float(truth["h"]))
     total = time.perf_counter() - t0
@@ -58,16 +82,7 @@ def main():
     for line in s.last_phases.splitlines():
         print("bench:   " + line)
     print("bench: IoU %.3f" % (len(got & want) / max(1, len(got | want))))
-
-    # The transfer pieces on their own, a few times each (they are fast).
-    api, mesh_io = mod.api, mod.mesh_io
-    for name, fn in (("selection + click order", lambda: api.selected_picks(obj)),
-                     ("foreach_get vertices + loop triangles", lambda: mesh_io.read_buffers(obj.data)),
-                     ("vertex group write", lambda: mesh_io.write_vertex_group(obj, "Relief", sorted(got)))):
-        best = min(_timed(fn) for _ in range(3))
-        print("bench:   %-40s %.3f s" % (name, best))
-    sys.stdout.flush()
-    os._exit(0)
+    return got
 
 
 def _timed(fn):

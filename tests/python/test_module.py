@@ -1,7 +1,9 @@
 """relief_snake_core: buffers in, errors out, progress/cancellation, GIL, Mesh reuse, results.
 
 Runs without numpy (numpy cases are skipped when it is missing). The module is
-found in the build directory: $RELIEF_SNAKE_BUILD_DIR, else ./build.
+found in the build directory: $RELIEF_SNAKE_BUILD_DIR, else ./build (as in conftest.py);
+a missing module fails the suite. RELIEF_SNAKE_TEST_BUDGET (seconds, default 60) bounds each
+segmentation so a runaway engine fails instead of hanging.
 """
 import array
 import math
@@ -19,7 +21,11 @@ BUILD_DIR = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build")
 if BUILD_DIR not in sys.path:
     sys.path.insert(0, BUILD_DIR)
 
-core = pytest.importorskip("relief_snake_core", reason="relief_snake_core not built (make build)")
+try:
+    import relief_snake_core as core
+except ImportError as exc:  # a suite that cannot run must fail, not skip
+    pytest.fail("relief_snake_core not importable from %s (%s): build it (make build) or set "
+                "RELIEF_SNAKE_BUILD_DIR" % (BUILD_DIR, exc), pytrace=False)
 
 try:
     import numpy as np
@@ -30,11 +36,11 @@ needs_numpy = pytest.mark.skipif(np is None, reason="numpy not installed")
 
 # --- a synthetic scan: a disk relief of radius R and step h on a jittered grid ----------------
 
-def disk_scan(n=48, size=40.0, radius=9.0, h=1.5, jitter=0.3, seed=1):
+def disk_scan(n=48, size=40.0, radius=9.0, h=1.0, jitter=0.3, seed=1):
     """Plane z=0 with the disk r < radius raised to z=h (sharp step), on an n x n jittered grid.
 
     Returns (vertices as list of (x, y, z), triangles as list of (i, j, k) counter-clockwise
-    seen from +z, picks: 8 vertices on a ring of radius radius + 2 h in counter-clockwise
+    seen from +z, picks: 8 vertices on a ring of radius radius + 3 h in counter-clockwise
     order, truth: set of the relief's vertices, h, radius)."""
     rng = random.Random(seed)
     step = size / (n - 1)
@@ -57,7 +63,7 @@ def disk_scan(n=48, size=40.0, radius=9.0, h=1.5, jitter=0.3, seed=1):
     picks = []
     for k in range(8):
         t = 2 * math.pi * k / 8
-        px, py = (radius + 2 * h) * math.cos(t), (radius + 2 * h) * math.sin(t)
+        px, py = (radius + 3 * h) * math.cos(t), (radius + 3 * h) * math.sin(t)
         picks.append(min(range(len(vertices)),
                          key=lambda v: (vertices[v][0] - px) ** 2 + (vertices[v][1] - py) ** 2))
     truth = {v for v, p in enumerate(vertices) if p[2] > 0}
@@ -311,10 +317,30 @@ def test_too_few_picks_is_an_error(scan):
 PHASES = {"preprocess", "coarse", "refine", "stabilise"}
 
 
+# A 4.4k-triangle disk takes well under a second; a run past this budget is a failure, not a hang.
+BUDGET_SECONDS = float(os.environ.get("RELIEF_SNAKE_TEST_BUDGET", "60"))
+
+
+class OverBudget(Exception):
+    pass
+
+
+def deadline(seconds=BUDGET_SECONDS):
+    """A progress callback that fails the segmentation once it runs longer than `seconds`."""
+    start = time.perf_counter()
+
+    def progress(phase, iteration, snaxels, contour):
+        if time.perf_counter() - start > seconds:
+            raise OverBudget("segmentation still in %s after %.0f s (iteration %d, %d snaxels)"
+                             % (phase, seconds, iteration, snaxels))
+
+    return progress
+
+
 @pytest.fixture(scope="module")
 def disk_result(scan):
     V, F, picks, _, h, _ = scan
-    return core.segment(V, F, picks, h)
+    return core.segment(V, F, picks, h, progress=deadline())
 
 
 def test_result_dict_structure(scan, disk_result):
@@ -349,7 +375,7 @@ def test_disk_relief_is_found(scan, disk_result):
     found = set(disk_result["relief_vertices"])
     iou = len(found & truth) / len(found | truth)
     assert iou > 0.85, iou
-    # the contour runs along the step, not around the picks (which are 2 h outside)
+    # the contour runs along the step, not around the picks (which are 3 h outside)
     off = [abs(math.hypot(x, y) - radius) for x, y, _ in disk_result["contour"]]
     assert sum(off) / len(off) < 0.75 * h
 
@@ -357,8 +383,8 @@ def test_disk_relief_is_found(scan, disk_result):
 def test_mesh_reuse_gives_the_same_result_twice(scan, disk_result):
     V, F, picks, _, h, _ = scan
     m = core.Mesh(V, F)
-    first = m.segment(picks, h)
-    second = m.segment(picks, h)
+    first = m.segment(picks, h, progress=deadline())
+    second = m.segment(picks, h, progress=deadline())
     for r in (first, second):
         assert r["relief_vertices"] == disk_result["relief_vertices"]
         assert r["contour"] == pytest.approx(disk_result["contour"])
@@ -367,7 +393,8 @@ def test_mesh_reuse_gives_the_same_result_twice(scan, disk_result):
 
 def test_inputs_in_other_forms_give_the_same_segmentation(scan, disk_result):
     V, F, picks, _, h, _ = scan
-    r = core.segment(array.array("d", flat(V)), array.array("q", flat(F)), array.array("l", picks), h)
+    r = core.segment(array.array("d", flat(V)), array.array("q", flat(F)), array.array("l", picks), h,
+                     progress=deadline())
     assert r["relief_vertices"] == disk_result["relief_vertices"]
 
 
@@ -377,10 +404,13 @@ def test_progress_arguments(scan):
     V, F, picks, _, h, _ = scan
     calls = []
 
+    budget = deadline()
+
     def progress(phase, iteration, snaxels, contour):
         calls.append((phase, iteration, snaxels, contour))
+        budget(phase, iteration, snaxels, contour)  # returns None: continue
 
-    result = core.segment(V, F, picks, h, progress=progress)  # returning None continues
+    result = core.segment(V, F, picks, h, progress=progress)
     assert calls
     for phase, iteration, snaxels, contour in calls:
         assert isinstance(phase, str) and phase in PHASES
@@ -424,35 +454,38 @@ def test_progress_exception_is_reraised(scan):
         m.segment(picks, h, progress=progress)
     assert e.value is boom and len(calls) == 1
     # the mesh is still usable afterwards
-    assert m.segment(picks, h)["relief_vertices"]
+    assert m.segment(picks, h, progress=deadline())["relief_vertices"]
 
 
-def test_gil_is_released_during_segmentation(scan):
+def test_gil_is_released_during_segmentation(scan, disk_result):
+    # disk_result first: it proves the segmentation ends (this test cannot use a deadline callback)
     V, F, picks, _, h, _ = scan
     m = core.Mesh(V, F)
-    count = [0]
+    stamps = []
     stop = threading.Event()
     started = threading.Event()
 
     def spin():
         started.set()
         while not stop.is_set():
-            count[0] += 1
+            stamps.append(time.perf_counter())
 
     t = threading.Thread(target=spin)
     t.start()
     started.wait()
     try:
-        before = count[0]
         t0 = time.perf_counter()
         m.segment(picks, h)  # no progress callback: the only way the thread runs is a released GIL
-        elapsed = time.perf_counter() - t0
-        during = count[0] - before
+        t1 = time.perf_counter()
     finally:
         stop.set()
         t.join()
-    assert elapsed > 0
-    assert during > 1000, (during, elapsed)
+    elapsed = t1 - t0
+    assert elapsed > 0.01, "segmentation too fast (%.4f s) to observe the GIL" % elapsed
+    # With the GIL held the thread would be frozen for the whole call: require that it kept
+    # running in the middle half of the call, away from the Python code at either end.
+    middle = [s for s in stamps if t0 + 0.25 * elapsed < s < t0 + 0.75 * elapsed]
+    assert len(middle) > 100, (len(middle), elapsed)
 
 
 def test_two_threads_on_one_mesh(scan, disk_result):
@@ -461,7 +494,7 @@ def test_two_threads_on_one_mesh(scan, disk_result):
     results = [None, None]
 
     def run(k):
-        results[k] = m.segment(picks, h, progress=lambda *a: None)
+        results[k] = m.segment(picks, h, progress=deadline())
 
     threads = [threading.Thread(target=run, args=(k,)) for k in range(2)]
     for t in threads:

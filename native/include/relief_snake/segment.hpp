@@ -30,10 +30,10 @@ struct Options {
   int max_iterations = 3000;       ///< cap per phase
 
   // Normalisation of the feature energy (our reading of 7.2.3, see docs/design.md).
-  double feature_contrast = 0.5;   ///< planarity contrast, in units of h, that scores E_f = -1 at l = h
+  double feature_contrast = 0.25;  ///< planarity contrast, in units of h, that scores E_f = -1 at l = h
   bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
   bool convex_barrier = false;     ///< penalise sitting on the step's top edge (not in the paper)
-  bool remove_loops = true;        ///< cut off loops where the snake crosses itself (not in the paper)
+  bool remove_loops = false;       ///< cut off loops where the snake crosses itself (not in the paper; experimental)
 };
 
 enum class Status {
