@@ -54,7 +54,8 @@ def make_scan(out_dir):
             if not os.path.exists(tool):
                 _fail("%s not found: build it first (make build)" % tool)
             cmd = [tool, "--shape", "duck", "--background", "plane", "--triangles",
-                   os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "20000"), "--seed", "1", "--out", prefix]
+                   os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "60000"), "--step", "blended",
+                   "--seed", "1", "--out", prefix]
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     with open(prefix + ".truth.json") as f:
         return prefix, json.load(f)
