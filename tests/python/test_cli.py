@@ -120,13 +120,14 @@ def test_segment_synthetic_scan(cli, build_dir, tmp_path):
     if not make_scan.is_file():
         pytest.fail(f"{make_scan} not found: build the make-scan target")
     prefix = tmp_path / "disk"
-    r = subprocess.run([str(make_scan), "--shape", "disk", "--triangles", "20000", "--out", str(prefix)],
+    r = subprocess.run([str(make_scan), "--shape", "disk", "--triangles", "60000", "--step", "blended",
+                        "--out", str(prefix)],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     truth = json.loads(Path(f"{prefix}.truth.json").read_text())
     out = tmp_path / "result.json"
     picks = ",".join(str(p) for p in truth["picks"])
-    r = run(cli, "segment", truth["mesh"], "--picks", picks, "--step-height", truth["h"], "--out", out, timeout=300)
+    r = run(cli, "segment", f"{prefix}.ply", "--picks", picks, "--step-height", truth["h"], "--out", out, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout == ""
     assert "loaded" in r.stderr and "coarse" in r.stderr  # progress on stderr
