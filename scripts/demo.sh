@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 BUILD_DIR=${BUILD_DIR:-build}
 OUT=${DEMO_OUT:-demo-output}
-TRIANGLES=${DEMO_TRIANGLES:-100000}
+TRIANGLES=${DEMO_TRIANGLES:-60000}
 PYTHON=${PYTHON:-python3}
 
 if ! ls "$BUILD_DIR"/relief_snake_core*.so >/dev/null 2>&1 || [ ! -x "$BUILD_DIR/make-scan" ]; then
@@ -19,7 +19,7 @@ command -v blender >/dev/null 2>&1 || scripts/install-blender.sh
 
 mkdir -p "$OUT"
 echo "demo: writing the sample scan ($TRIANGLES triangles) to $OUT/duck.ply"
-"$BUILD_DIR/make-scan" --shape duck --background plane --triangles "$TRIANGLES" --noise 0.02 --seed 7 \
+"$BUILD_DIR/make-scan" --shape duck --background plane --triangles "$TRIANGLES" --step blended --seed 1 \
   --out "$OUT/duck" >/dev/null
 
 echo "demo: segmenting in $(blender --version 2>/dev/null | head -1) (headless)"
