@@ -302,19 +302,8 @@ int run_segment(const std::vector<std::string>& args) {
                      {"epsilon", o.epsilon},
                      {"q_samples", o.q_samples},
                      {"max_turn_degrees", o.max_turn_degrees},
-                     {"lock_interval", o.lock_interval},
-                     {"coarse_spacing", d.coarse_spacing},
-                     {"refine_spacing", d.refine_spacing},
-                     {"alpha_coarse", d.alpha_coarse},
-                     {"beta_coarse", d.beta_coarse},
-                     {"alpha_refine", d.alpha_refine},
-                     {"beta_refine", d.beta_refine},
-                     {"gamma", d.gamma},
-                     {"sigma_background", d.sigma_background},
-                     {"sigma_s", d.sigma_s},
-                     {"w_f", d.w_f},
-                     {"w_d", d.w_d},
-                     {"average_edge", d.average_edge}};
+                     {"lock_interval", o.lock_interval}};
+  for (const auto& [name, value] : d.named_values()) parameters[name] = value;
   const json out = {{"status", rs::to_string(result.status)},
                     {"closed", result.closed},
                     {"contour", contour},

@@ -271,19 +271,7 @@ py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, double
   }
   const DerivedParameters& d = r.parameters;
   py::dict parameters;
-  parameters["coarse_spacing"] = d.coarse_spacing;
-  parameters["refine_spacing"] = d.refine_spacing;
-  parameters["alpha_coarse"] = d.alpha_coarse;
-  parameters["beta_coarse"] = d.beta_coarse;
-  parameters["alpha_refine"] = d.alpha_refine;
-  parameters["beta_refine"] = d.beta_refine;
-  parameters["gamma"] = d.gamma;
-  parameters["sigma_background"] = d.sigma_background;
-  parameters["sigma_s"] = d.sigma_s;
-  parameters["w_int"] = d.w_int;
-  parameters["w_f"] = d.w_f;
-  parameters["w_d"] = d.w_d;
-  parameters["average_edge"] = d.average_edge;
+  for (const auto& [name, value] : d.named_values()) parameters[name] = value;
   parameters["step_height"] = o.step_height;
   parameters["open"] = !o.closed;
   parameters["relief_side"] = o.relief_side == ReliefSide::Left ? "left" : "right";

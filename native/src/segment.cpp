@@ -25,6 +25,14 @@ const char* to_string(Status status) {
   return "unknown";
 }
 
+std::vector<std::pair<const char*, double>> DerivedParameters::named_values() const {
+  return {{"coarse_spacing", coarse_spacing}, {"refine_spacing", refine_spacing}, {"alpha_coarse", alpha_coarse},
+          {"beta_coarse", beta_coarse},       {"alpha_refine", alpha_refine},     {"beta_refine", beta_refine},
+          {"gamma", gamma},                   {"sigma_background", sigma_background}, {"sigma_s", sigma_s},
+          {"w_int", w_int},                   {"w_f", w_f},                       {"w_d", w_d},
+          {"average_edge", average_edge}};
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;

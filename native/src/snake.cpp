@@ -212,6 +212,15 @@ int Snake::remove_sharp_turns(double max_degrees) {
   return removed;
 }
 
+int Snake::append_between(int i, int j, int pieces, std::vector<Snaxel>* out) const {
+  if (pieces < 2) return 0;
+  std::vector<double> fractions;
+  for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
+  for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions))
+    out->push_back(make(p));  // new snaxels start as moved
+  return pieces - 1;
+}
+
 int Snake::resample(double l) {
   const double lmin = 0.5 * l, lmax = 1.5 * l;
   int changes = 0;
@@ -224,17 +233,7 @@ int Snake::resample(double l) {
     const int j = next(i);
     if (j < 0) continue;
     const double d = (snaxels_[j].position - snaxels_[i].position).norm();
-    if (d > lmax) {
-      const int pieces = static_cast<int>(std::ceil(d / l));
-      std::vector<double> fractions;
-      for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
-      for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions)) {
-        out.push_back(make(p));
-        ++changes;
-      }
-      out.back().moved = true;
-      snaxels_[i].moved = true;
-    }
+    if (d > lmax) changes += append_between(i, j, static_cast<int>(std::ceil(d / l)), &out);
   }
   snaxels_.swap(out);
   // Merge pass: replace a too-short pair by its midpoint (open ends stay put).
@@ -316,6 +315,7 @@ int Snake::remove_loops() {
       const Vec3& p0 = snaxels_[i].position;
       const Vec3& p1 = snaxels_[next(i)].position;
       const Key k = key_of(0.5 * (p0 + p1));
+      const Vec3 nrm = normal(mesh_, snaxels_[i].point);
       for (long dx = -1; dx <= 1 && cut_a < 0; ++dx)
         for (long dy = -1; dy <= 1 && cut_a < 0; ++dy)
           for (long dz = -1; dz <= 1 && cut_a < 0; ++dz) {
@@ -323,7 +323,6 @@ int Snake::remove_loops() {
             if (it == grid.end()) continue;
             for (int j : it->second) {
               if (j <= i + 1 || (closed_ && i == 0 && j == segments - 1)) continue;
-              const Vec3 nrm = normal(mesh_, snaxels_[i].point);
               if (segments_cross(p0, p1, snaxels_[j].position, snaxels_[next(j)].position, nrm)) {
                 cut_a = i;
                 cut_b = j;
@@ -359,12 +358,7 @@ void Snake::subdivide(double l) {
     const int j = next(i);
     if (j < 0) continue;
     const double d = (snaxels_[j].position - snaxels_[i].position).norm();
-    const int pieces = std::max(1, static_cast<int>(std::lround(d / l)));
-    std::vector<double> fractions;
-    for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
-    if (fractions.empty()) continue;
-    for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions))
-      out.push_back(make(p));
+    append_between(i, j, static_cast<int>(std::lround(d / l)), &out);
   }
   snaxels_.swap(out);
 }

@@ -118,17 +118,17 @@ int nearest_corner(const Mesh& mesh, const SurfacePoint& p) {
   return mesh.face_vertex(p.face, k);
 }
 
-Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double distance) {
-  return walk_sampled(mesh, start, direction, {distance}, nullptr);
-}
+namespace {
 
-Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
-                  const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
+// The walk behind walk() and walk_sampled(); distances as a plain array so a
+// single-distance walk (the snake's inner loop) allocates nothing.
+Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
+               std::size_t n_samples, std::vector<SurfacePoint>* samples) {
   Walk result;
   result.end = start;
   if (samples) samples->clear();
-  if (sample_distances.empty() || !start.valid()) return result;
-  const double total = sample_distances.back();
+  if (n_samples == 0 || !start.valid()) return result;
+  const double total = sample_distances[n_samples - 1];
 
   int f = start.face;
   Vec3 b = start.bary;
@@ -136,8 +136,8 @@ Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direc
   result.direction = d;
   if (d.isZero() || !(total > 0)) {
     if (samples)
-      for (double s : sample_distances)
-        if (s <= 0) samples->push_back(start);
+      for (std::size_t k = 0; k < n_samples; ++k)
+        if (sample_distances[k] <= 0) samples->push_back(start);
     return result;
   }
 
@@ -162,7 +162,7 @@ Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direc
       }
     }
     // Emit samples that fall inside this face.
-    while (next_sample < sample_distances.size() && sample_distances[next_sample] - travelled <= t_exit) {
+    while (next_sample < n_samples && sample_distances[next_sample] - travelled <= t_exit) {
       const double t = std::max(0.0, sample_distances[next_sample] - travelled);
       SurfacePoint s{f, b + t * db};
       s.bary = s.bary.cwiseMax(0.0);
@@ -170,7 +170,7 @@ Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direc
       if (samples) samples->push_back(s);
       ++next_sample;
     }
-    if (next_sample == sample_distances.size()) {
+    if (next_sample == n_samples) {
       const double t = total - travelled;
       result.end.face = f;
       result.end.bary = (b + t * db).cwiseMax(0.0);
@@ -234,6 +234,17 @@ Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direc
   result.travelled = travelled;
   result.direction = d;
   return result;
+}
+
+}  // namespace
+
+Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double distance) {
+  return walk_impl(mesh, start, direction, &distance, 1, nullptr);
+}
+
+Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
+                  const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
+  return walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), samples);
 }
 
 }  // namespace relief_snake

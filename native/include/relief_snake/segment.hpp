@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "relief_snake/mesh.hpp"
@@ -59,6 +60,8 @@ struct DerivedParameters {
   double sigma_s = 0;           ///< bilateral similarity sigma
   double w_int = 0, w_f = 1, w_d = 0;
   double average_edge = 0;
+  /// Every field with its name, for reports (CLI JSON, Python dict).
+  std::vector<std::pair<const char*, double>> named_values() const;
 };
 
 struct Result {

@@ -65,6 +65,8 @@ class Snake {
 
  private:
   Snaxel make(const SurfacePoint& p) const;
+  /// Appends the pieces - 1 points that cut segment (i, j) into equal pieces; returns how many.
+  int append_between(int i, int j, int pieces, std::vector<Snaxel>* out) const;
   const Mesh& mesh_;
   std::vector<Snaxel> snaxels_;
   bool closed_, inside_left_;
