@@ -79,18 +79,17 @@ std::vector<Case> cases() {
   std::vector<Case> out;
   out.push_back(make("disk_blended", syn::Shape::Disk, syn::Step::Blended));
   out.push_back(make("disk_sharp", syn::Shape::Disk, syn::Step::Sharp));
-  // The duck with its deep concavity is not reliable yet with the defaults (at 150k triangles the
-  // refinement breaks through the step): known failure, reported in issue 2; the benchmark tracks it.
+  Case duck = make("duck_blended_concavity", syn::Shape::Duck, syn::Step::Blended);
+  duck.triangles = 150000;
+  out.push_back(duck);
   Case far = make("disk_far_start", syn::Shape::Disk, syn::Step::Blended);
   far.start = syn::Start::Far;
   out.push_back(far);
   Case zigzag = make("disk_zigzag_start", syn::Shape::Disk, syn::Step::Blended);
   zigzag.start = syn::Start::Zigzag;
   out.push_back(zigzag);
-  // h x 0.6 (the paper's lower bound) still breaks through in refinement here:
-  // known failure, reported in the issue; x 0.7 is the lowest factor that passes.
-  Case low = make("disk_h_x0.7", syn::Shape::Disk, syn::Step::Blended);
-  low.h_factor = 0.7;
+  Case low = make("disk_h_x0.6", syn::Shape::Disk, syn::Step::Blended);
+  low.h_factor = 0.6;
   out.push_back(low);
   Case high = make("disk_h_x1.4", syn::Shape::Disk, syn::Step::Blended);
   high.h_factor = 1.4;
@@ -101,7 +100,9 @@ std::vector<Case> cases() {
   Case sphere = make("disk_on_sphere", syn::Shape::Disk, syn::Step::Blended);
   sphere.background = syn::Background::Sphere;
   out.push_back(sphere);
-  // The saddle background breaks through in refinement: known failure, reported in the issue.
+  Case saddle = make("disk_on_saddle", syn::Shape::Disk, syn::Step::Blended);
+  saddle.background = syn::Background::Saddle;
+  out.push_back(saddle);
   Case open = make("open_relief", syn::Shape::Open, syn::Step::Blended);
   out.push_back(open);
   return out;

@@ -102,3 +102,26 @@ TEST(Snake, SubdivideReachesTheRequestedSpacing) {
   for (int i = 0; i < snake.size(); ++i)
     EXPECT_NEAR((snake[snake.next(i)].position - snake[i].position).norm(), expected, 0.1);
 }
+
+TEST(Snake, RemoveLoopsCutsTheSmallSideOfACrossing) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  // A circle of 24 snaxels with a small twisted loop: snaxels 6 and 7 swapped
+  // across the curve make segments 5-6 and 7-8 cross.
+  std::vector<SurfacePoint> pts = circle(mesh, Vec3(10, 10, 0), 5, 24);
+  std::swap(pts[6], pts[7]);
+  Snake snake(mesh, pts, true, true);
+  const int removed = snake.remove_loops();
+  EXPECT_GE(removed, 1);
+  EXPECT_LE(removed, 3);
+  EXPECT_EQ(snake.remove_loops(), 0);  // nothing left to cut
+  // Most of the circle survives.
+  EXPECT_GE(snake.size(), 21);
+  for (int i = 0; i < snake.size(); ++i) EXPECT_NEAR((snake[i].position - Vec3(10, 10, 0)).norm(), 5, 0.1);
+}
+
+TEST(Snake, RemoveLoopsLeavesASimpleCurveAlone) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 40), true, true);
+  EXPECT_EQ(snake.remove_loops(), 0);
+  EXPECT_EQ(snake.size(), 40);
+}

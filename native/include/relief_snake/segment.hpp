@@ -34,7 +34,7 @@ struct Options {
   double feature_contrast = 0.25;  ///< planarity contrast, in units of h, that scores E_f = -1 at l = h
   bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
   bool convex_barrier = false;     ///< penalise sitting on the step's top edge (not in the paper)
-  bool remove_loops = false;       ///< cut off loops where the snake crosses itself (not in the paper; experimental)
+  bool remove_loops = true;        ///< cut off loops where the snake crosses itself (not in the paper)
 };
 
 enum class Status {
