@@ -45,22 +45,47 @@ FeatureEnergy::FeatureEnergy(PlanarityField& planarity, double h, double epsilon
 }
 
 double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
-  walk_sampled(planarity_.mesh(), x, inward, distances_, &samples_);
-  if (samples_.empty()) return 0;  // the mesh ends before (1 - eps) h: no step inside
-  double q_value = std::numeric_limits<double>::infinity();
-  for (const SurfacePoint& q : samples_) {
-    const double value = planarity_.filtered(q);
-    if (value < q_value) {
-      q_value = value;
-      last_q_ = q;
+  double value = 0;
+  unscaled(&x, 1, inward, &value);
+  return value;
+}
+
+void FeatureEnergy::unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out) {
+  const Mesh& mesh = planarity_.mesh();
+  if (static_cast<int>(samples_.size()) < count) samples_.resize(count);
+  // Gather every face corner first, so the missing planarity is one parallel batch.
+  vertices_.clear();
+  auto corners = [&](const SurfacePoint& p) {
+    if (!p.valid() || p.face >= mesh.n_faces()) return;  // filtered() reports it below
+    for (int k = 0; k < 3; ++k) vertices_.push_back(mesh.face_vertex(p.face, k));
+  };
+  for (int i = 0; i < count; ++i) {
+    walk_sampled(mesh, xs[i], inward, distances_, &samples_[i]);
+    corners(xs[i]);
+    for (const SurfacePoint& q : samples_[i]) corners(q);
+  }
+  planarity_.prefetch_filtered(vertices_);
+
+  for (int i = 0; i < count; ++i) {
+    out[i] = 0;
+    if (samples_[i].empty()) continue;  // the mesh ends before (1 - eps) h: no step inside
+    double q_value = std::numeric_limits<double>::infinity();
+    for (const SurfacePoint& q : samples_[i]) {
+      const double value = planarity_.filtered(q);
+      if (value < q_value) {
+        q_value = value;
+        last_q_ = q;
+      }
+    }
+    const double d = planarity_.filtered(xs[i]) - q_value;
+    if (d > 0) {
+      out[i] = d * d;
+    } else if (convex_barrier_) {
+      // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
+      // is penalised instead of ignored, so it cannot slip past the step's top edge.
+      out[i] = -d * d;
     }
   }
-  const double px = planarity_.filtered(x);
-  const double d = px - q_value;
-  if (d > 0) return d * d;
-  // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
-  // is penalised instead of ignored, so it cannot slip past the step's top edge.
-  return convex_barrier_ ? -d * d : 0.0;
 }
 
 }  // namespace relief_snake

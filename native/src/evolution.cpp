@@ -4,7 +4,7 @@
 
 namespace relief_snake {
 
-double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, const Vec3& inward, FeatureEnergy& feature,
+double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, double feature_unscaled,
                      const PhaseSettings& phase) {
   const Vec3 p = position(snake.mesh(), x);
   const int ip = snake.prev(i), in = snake.next(i);
@@ -18,9 +18,7 @@ double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, const Vec
     const Vec3& a = snake[ip >= 0 ? ip : in].position;
     internal = tension_energy(phase.alpha, a, p, a);
   }
-  double energy = phase.w_int * internal;
-  if (phase.w_f != 0 && phase.gamma != 0) energy -= phase.w_f * phase.gamma * feature.unscaled(x, inward);
-  return energy;
+  return phase.w_int * internal - phase.w_f * phase.gamma * feature_unscaled;
 }
 
 int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase) {
@@ -53,11 +51,15 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
       inside = walk(mesh, s.point, inward, step).end;
       outside = walk(mesh, s.point, -inward, step).end;
     }
-    const double e_stay = snaxel_energy(snake, i, s.point, inward, feature, phase);
-    double e_in = snaxel_energy(snake, i, inside, inward, feature, phase);
+    // Stay, inside, outside: one planarity batch for the three.
+    const SurfacePoint candidates[3] = {s.point, inside, outside};
+    double f[3] = {0, 0, 0};
+    if (phase.w_f != 0 && phase.gamma != 0) feature.unscaled(candidates, 3, inward, f);
+    const double e_stay = snaxel_energy(snake, i, s.point, f[0], phase);
+    double e_in = snaxel_energy(snake, i, inside, f[1], phase);
     if (phase.w_d != 0)
       e_in += phase.w_d * deflation_energy(phase.alpha, phase.beta, phase.tau, li, phase.gamma_sigma2);
-    const double e_out = snaxel_energy(snake, i, outside, inward, feature, phase);
+    const double e_out = snaxel_energy(snake, i, outside, f[2], phase);
     if (e_in < e_stay && e_in <= e_out) {
       snake.move(i, inside);
     } else if (e_out < e_stay && e_out < e_in) {

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "relief_snake/error.hpp"
+#include "worker_pool.hpp"
 
 namespace relief_snake {
 
@@ -87,8 +88,19 @@ PlanarityField::PlanarityField(const Mesh& mesh, const PlanarityOptions& options
   const std::size_t n = static_cast<std::size_t>(mesh.n_vertices());
   raw_.assign(n, kNaN);
   filtered_.assign(n, kNaN);
-  distance_.assign(n, kInf);
-  accepted_.assign(n, 0);
+  scratch(0);
+}
+
+PlanarityField::~PlanarityField() = default;
+
+PlanarityField::Scratch& PlanarityField::scratch(int worker) {
+  if (static_cast<int>(scratch_.size()) <= worker) scratch_.resize(worker + 1);
+  Scratch& s = scratch_[worker];
+  if (s.distance.empty() && mesh_.n_vertices() > 0) {
+    s.distance.assign(mesh_.n_vertices(), kInf);
+    s.accepted.assign(mesh_.n_vertices(), 0);
+  }
+  return s;
 }
 
 void PlanarityField::check_vertex(int v) const {
@@ -101,7 +113,7 @@ double PlanarityField::raw(int v) {
   check_vertex(v);
   double& value = raw_[v];
   if (std::isnan(value)) {
-    value = compute_raw(v);
+    value = compute_raw(v, scratch_[0]);
     ++raw_count_;
   }
   return value;
@@ -125,52 +137,59 @@ double PlanarityField::filtered(const SurfacePoint& p) {
   return interpolate(mesh_, p, [this](int v) { return filtered(v); });
 }
 
-void PlanarityField::reset_scratch() {
+void PlanarityField::reset(Scratch& s) {
   // Only the entries this call touched: O(ball), never O(#V).
-  for (int u : touched_) {
-    distance_[u] = kInf;
-    accepted_[u] = 0;
+  for (int u : s.touched) {
+    s.distance[u] = kInf;
+    s.accepted[u] = 0;
   }
-  touched_.clear();
-  heap_.clear();
+  s.touched.clear();
+  s.heap.clear();
 }
 
-void PlanarityField::march(int v) {
+void PlanarityField::march(int v, Scratch& s) const {
   const double h = options_.radius;
   using Entry = std::pair<double, int>;
   const auto later = std::greater<Entry>();  // min-heap on distance
-  ball_.clear();
-  heap_.clear();
-  touched_.clear();
+  std::vector<double>& distance = s.distance;
+  std::vector<char>& accepted = s.accepted;
+  std::vector<std::pair<double, int>>& heap = s.heap;
+  s.ball.clear();
+  heap.clear();
+  s.touched.clear();
 
-  distance_[v] = 0;
-  touched_.push_back(v);
-  heap_.emplace_back(0.0, v);
+  distance[v] = 0;
+  s.touched.push_back(v);
+  heap.emplace_back(0.0, v);
 
+  // Geodesic distance is at least the straight one: vertices outside the
+  // Euclidean h-ball can never enter the ball nor serve as upwind values.
+  const Vec3 pv = mesh_.position(v);
+  const double h2 = h * h;
+  auto reachable = [&](int u) { return (mesh_.position(u) - pv).squaredNorm() <= h2; };
   auto offer = [&](int u, double d) {
-    // Values beyond h can never enter the ball nor serve as upwind values, so skip them.
-    if (!(d <= h) || !(d < distance_[u])) return;
-    if (distance_[u] == kInf) touched_.push_back(u);
-    distance_[u] = d;
-    heap_.emplace_back(d, u);
-    std::push_heap(heap_.begin(), heap_.end(), later);
+    if (!(d <= h) || !(d < distance[u])) return;
+    if (distance[u] == kInf) s.touched.push_back(u);
+    distance[u] = d;
+    heap.emplace_back(d, u);
+    std::push_heap(heap.begin(), heap.end(), later);
   };
 
-  while (!heap_.empty()) {
-    std::pop_heap(heap_.begin(), heap_.end(), later);
-    const Entry top = heap_.back();
-    heap_.pop_back();
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const Entry top = heap.back();
+    heap.pop_back();
     const int u = top.second;
-    if (accepted_[u] || top.first > distance_[u]) continue;  // stale entry
-    accepted_[u] = 1;
-    ball_.push_back(u);
-    const double du = distance_[u];
+    if (accepted[u] || top.first > distance[u]) continue;  // stale entry
+    accepted[u] = 1;
+    s.ball.push_back(u);
+    const double du = distance[u];
     const Vec3& pu = mesh_.position(u);
 
     // Dijkstra edge updates: always available, exact along edges.
     for (const int* it = mesh_.neighbors_begin(u); it != mesh_.neighbors_end(u); ++it) {
       const int w = *it;
-      if (!accepted_[w]) offer(w, du + (mesh_.position(w) - pu).norm());
+      if (!accepted[w] && reachable(w)) offer(w, du + (mesh_.position(w) - pu).norm());
     }
     // Triangle updates through every face with u and one other accepted corner.
     for (const int* it = mesh_.faces_begin(u); it != mesh_.faces_end(u); ++it) {
@@ -181,11 +200,12 @@ void PlanarityField::march(int v) {
         if (c == u) continue;
         (a < 0 ? a : b) = c;
       }
-      if (accepted_[a] == accepted_[b]) continue;  // need exactly one known corner besides u
-      if (accepted_[a]) std::swap(a, b);           // now a is the target, b is known
+      if (accepted[a] == accepted[b]) continue;  // need exactly one known corner besides u
+      if (accepted[a]) std::swap(a, b);           // now a is the target, b is known
+      if (!reachable(a)) continue;
       const Vec3 &pa = mesh_.position(a), &pb = mesh_.position(b);
-      double d = point_source_update(pu, pb, pa, du, distance_[b]);
-      if (d == kInf) d = triangle_update(pu, pb, pa, du, distance_[b]);
+      double d = point_source_update(pu, pb, pa, du, distance[b]);
+      if (d == kInf) d = triangle_update(pu, pb, pa, du, distance[b]);
       offer(a, d);
     }
   }
@@ -193,25 +213,50 @@ void PlanarityField::march(int v) {
 
 void PlanarityField::geodesic_ball(int v, std::vector<int>* vertices, std::vector<double>* distances) {
   check_vertex(v);
-  march(v);
-  if (vertices) vertices->assign(ball_.begin() + 1, ball_.end());
+  Scratch& s = scratch_[0];
+  march(v, s);
+  if (vertices) vertices->assign(s.ball.begin() + 1, s.ball.end());
   if (distances) {
     distances->clear();
-    for (std::size_t i = 1; i < ball_.size(); ++i) distances->push_back(distance_[ball_[i]]);
+    for (std::size_t i = 1; i < s.ball.size(); ++i) distances->push_back(s.distance[s.ball[i]]);
   }
-  reset_scratch();
+  reset(s);
 }
 
-double PlanarityField::compute_raw(int v) {
-  march(v);
+void PlanarityField::euclidean_ball(int v, Scratch& s) const {
+  const Vec3 pv = mesh_.position(v);
+  const double h2 = options_.radius * options_.radius;
+  s.ball.clear();
+  s.touched.clear();
+  s.ball.push_back(v);
+  s.accepted[v] = 1;
+  s.touched.push_back(v);
+  for (std::size_t i = 0; i < s.ball.size(); ++i) {
+    const int u = s.ball[i];
+    for (const int* it = mesh_.neighbors_begin(u); it != mesh_.neighbors_end(u); ++it) {
+      const int w = *it;
+      if (s.accepted[w]) continue;
+      if ((mesh_.position(w) - pv).squaredNorm() > h2) continue;
+      s.accepted[w] = 1;
+      s.touched.push_back(w);
+      s.ball.push_back(w);
+    }
+  }
+}
+
+double PlanarityField::compute_raw(int v, Scratch& s) const {
+  if (options_.neighbourhood == Neighbourhood::Euclidean)
+    euclidean_ball(v, s);
+  else
+    march(v, s);
   if (options_.include_one_ring) {
     for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
-      if (!accepted_[*it]) ball_.push_back(*it);  // beyond h, but adjacent
+      if (!s.accepted[*it]) s.ball.push_back(*it);  // beyond h, but adjacent
   }
-  reset_scratch();
-  // ball_[0] is v itself; the neighbours are the rest.
-  const int* begin = ball_.data() + 1;
-  const int* end = ball_.data() + ball_.size();
+  reset(s);
+  // ball[0] is v itself; the neighbours are the rest.
+  const int* begin = s.ball.data() + 1;
+  const int* end = s.ball.data() + s.ball.size();
   if (end - begin < 3) {  // h smaller than the edges: fall back to the one-ring
     begin = mesh_.neighbors_begin(v);
     end = mesh_.neighbors_end(v);
@@ -246,32 +291,75 @@ double PlanarityField::compute_raw(int v) {
   return centroid.dot(normal);
 }
 
+void PlanarityField::two_ring(int v, Scratch& s, std::vector<int>* out) const {
+  // accepted is all zero between marches, so it serves as the visited mark.
+  std::vector<char>& seen = s.accepted;
+  out->clear();
+  seen[v] = 1;
+  for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it) {
+    if (!seen[*it]) {
+      seen[*it] = 1;
+      out->push_back(*it);
+    }
+  }
+  const std::size_t one_ring = out->size();
+  for (std::size_t i = 0; i < one_ring; ++i) {
+    const int w = (*out)[i];
+    for (const int* it = mesh_.neighbors_begin(w); it != mesh_.neighbors_end(w); ++it) {
+      if (!seen[*it]) {
+        seen[*it] = 1;
+        out->push_back(*it);
+      }
+    }
+  }
+  seen[v] = 0;
+  for (int w : *out) seen[w] = 0;
+}
+
+void PlanarityField::prefetch_raw(const std::vector<int>& vertices) {
+  // The batch: distinct vertices whose P is missing (NaN marks "queued" too).
+  batch_.clear();
+  std::vector<char>& queued = scratch_[0].accepted;
+  for (int v : vertices) {
+    check_vertex(v);
+    if (std::isnan(raw_[v]) && !queued[v]) {
+      queued[v] = 1;
+      batch_.push_back(v);
+    }
+  }
+  for (int v : batch_) queued[v] = 0;
+  if (batch_.empty()) return;
+  if (batch_.size() >= 2 && options_.threads != 1 && !pool_) pool_ = std::make_unique<WorkerPool>(options_.threads);
+  if (batch_.size() < 2 || !pool_ || pool_->size() == 1) {
+    for (int v : batch_) raw(v);
+    return;
+  }
+  for (int w = 0; w < pool_->size(); ++w) scratch(w);  // allocate before the threads start
+  // Each item writes only its own raw_ entry; compute_raw reads nothing shared but the mesh.
+  pool_->run(static_cast<int>(batch_.size()),
+             [this](int item, int worker) { raw_[batch_[item]] = compute_raw(batch_[item], scratch_[worker]); });
+  raw_count_ += batch_.size();
+}
+
+void PlanarityField::prefetch_filtered(const std::vector<int>& vertices) {
+  needed_.clear();
+  for (int v : vertices) {
+    check_vertex(v);
+    if (!std::isnan(filtered_[v])) continue;
+    needed_.push_back(v);
+    two_ring(v, scratch_[0], &ring_);
+    needed_.insert(needed_.end(), ring_.begin(), ring_.end());
+  }
+  prefetch_raw(needed_);
+  for (int v : vertices) filtered(v);
+}
+
 double PlanarityField::compute_filtered(int v) {
   if (!(sigma_s_ > 0))
     throw Error("programming error: filtered planarity needs sigma_s; call estimate_sigma_s() first or set "
                 "PlanarityOptions::sigma_s > 0");
-  // N(v) = v and its two-ring (edge-hop distance 1 and 2). accepted_ is all
-  // zero between marches, so it serves as the visited mark here.
-  ring_.clear();
-  accepted_[v] = 1;
-  for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it) {
-    if (!accepted_[*it]) {
-      accepted_[*it] = 1;
-      ring_.push_back(*it);
-    }
-  }
-  const std::size_t one_ring = ring_.size();
-  for (std::size_t i = 0; i < one_ring; ++i) {
-    const int w = ring_[i];
-    for (const int* it = mesh_.neighbors_begin(w); it != mesh_.neighbors_end(w); ++it) {
-      if (!accepted_[*it]) {
-        accepted_[*it] = 1;
-        ring_.push_back(*it);
-      }
-    }
-  }
-  accepted_[v] = 0;
-  for (int w : ring_) accepted_[w] = 0;
+  // N(v) = v and its two-ring (edge-hop distance 1 and 2).
+  two_ring(v, scratch_[0], &ring_);
 
   const Vec3& pv = mesh_.position(v);
   double max_dist2 = 0;
@@ -297,7 +385,7 @@ double PlanarityField::compute_filtered(int v) {
 void PlanarityField::estimate_sigma_s(const std::vector<int>& sample_vertices) {
   if (sample_vertices.empty())
     throw Error("estimate_sigma_s needs at least one sample vertex (e.g. the vertices along the initial contour)");
-  for (int v : sample_vertices) check_vertex(v);
+  prefetch_raw(sample_vertices);  // checks the indices
   // Two passes over the cached values: numerically safer than sum of squares.
   double mean = 0;
   for (int v : sample_vertices) mean += raw(v);

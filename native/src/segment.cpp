@@ -64,6 +64,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
     throw Error("max_turn_degrees must be in (0, 180]");
   if (o.lock_interval < 1) throw Error("lock_interval must be at least 1");
   if (o.max_iterations < 1) throw Error("max_iterations must be at least 1 (got " + std::to_string(o.max_iterations) + ")");
+  if (o.threads < 0) throw Error("threads must be 0 (all cores) or a positive count (got " + std::to_string(o.threads) + ")");
   if (!(o.feature_contrast > 0) || !std::isfinite(o.feature_contrast))
     throw Error("feature_contrast must be a positive number");
 }
@@ -110,7 +111,7 @@ std::vector<int> planarity_sample(const Mesh& mesh, const std::vector<SurfacePoi
 
 struct Segmenter::Cache {
   std::unique_ptr<PlanarityField> planarity;
-  double h = 0;
+  PlanarityOptions options;  // what it was computed with
 };
 
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
@@ -150,12 +151,17 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                                           : options.relief_side == ReliefSide::Left;
 
   // --- planarity (Sections 5.3, 7.2.1), reused between calls for the same h --
-  if (!cache_->planarity || cache_->h != h) {
-    PlanarityOptions po;
-    po.radius = h;
+  PlanarityOptions po;
+  po.radius = h;
+  po.threads = options.threads;
+  po.neighbourhood = options.neighbourhood;
+  po.include_one_ring = options.planarity_one_ring;
+  const PlanarityOptions& was = cache_->options;
+  if (!cache_->planarity || was.radius != h || was.neighbourhood != po.neighbourhood ||
+      was.include_one_ring != po.include_one_ring) {
     cache_->planarity = std::make_unique<PlanarityField>(mesh, po);
     cache_->planarity->estimate_sigma_s(planarity_sample(mesh, start, mesh.component(pick_vertices.front())));
-    cache_->h = h;
+    cache_->options = po;
   }
   PlanarityField& planarity = *cache_->planarity;
   param.sigma_s = planarity.sigma_s();

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
+
+#include <Eigen/Geometry>
 
 namespace relief_snake {
 
@@ -283,61 +284,66 @@ bool segments_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
 
 int Snake::remove_loops() {
   int removed = 0;
+  std::vector<int> order;
+  std::vector<Eigen::AlignedBox3d> boxes;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
     const int segments = closed_ ? n : n - 1;
     if (segments < 4) break;
-    // Uniform grid over segment bounding boxes; cell = longest segment.
-    double cell = 0;
-    for (int i = 0; i < segments; ++i)
-      cell = std::max(cell, (snaxels_[next(i)].position - snaxels_[i].position).norm());
-    if (!(cell > 0)) break;
-    struct Key {
-      long x, y, z;
-      bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-    };
-    struct KeyHash {
-      std::size_t operator()(const Key& k) const {
-        return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L);
-      }
-    };
-    std::unordered_map<Key, std::vector<int>, KeyHash> grid;
-    auto key_of = [&](const Vec3& p) {
-      return Key{static_cast<long>(std::floor(p.x() / cell)), static_cast<long>(std::floor(p.y() / cell)),
-                 static_cast<long>(std::floor(p.z() / cell))};
-    };
+    // Sweep and prune: segment boxes, grown by half the longest segment so
+    // that crossings seen along a tilted normal are not missed, sorted along
+    // the snake's longest axis; only boxes overlapping on all three axes are
+    // tested. O(n log n) per pass, no allocation after the first.
+    double longest = 0;
+    Eigen::AlignedBox3d extent;
+    boxes.resize(segments);
     for (int i = 0; i < segments; ++i) {
-      const Vec3 mid = 0.5 * (snaxels_[i].position + snaxels_[next(i)].position);
-      grid[key_of(mid)].push_back(i);
+      const Vec3 &p0 = snaxels_[i].position, &p1 = snaxels_[next(i)].position;
+      longest = std::max(longest, (p1 - p0).norm());
+      boxes[i] = Eigen::AlignedBox3d(p0.cwiseMin(p1), p0.cwiseMax(p1));
+      extent.extend(boxes[i]);
     }
+    if (!(longest > 0)) break;
+    const Vec3 margin = Vec3::Constant(0.5 * longest);
+    for (Eigen::AlignedBox3d& box : boxes) box = Eigen::AlignedBox3d(box.min() - margin, box.max() + margin);
+    int axis = 0;
+    extent.sizes().maxCoeff(&axis);
+    order.resize(segments);
+    for (int i = 0; i < segments; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return boxes[a].min()(axis) < boxes[b].min()(axis); });
+    // The crossing with the smallest first segment (then second), as a scan along the snake would find.
     int cut_a = -1, cut_b = -1;
-    for (int i = 0; i < segments && cut_a < 0; ++i) {
-      const Vec3& p0 = snaxels_[i].position;
-      const Vec3& p1 = snaxels_[next(i)].position;
-      const Key k = key_of(0.5 * (p0 + p1));
-      const Vec3 nrm = normal(mesh_, snaxels_[i].point);
-      for (long dx = -1; dx <= 1 && cut_a < 0; ++dx)
-        for (long dy = -1; dy <= 1 && cut_a < 0; ++dy)
-          for (long dz = -1; dz <= 1 && cut_a < 0; ++dz) {
-            auto it = grid.find(Key{k.x + dx, k.y + dy, k.z + dz});
-            if (it == grid.end()) continue;
-            for (int j : it->second) {
-              if (j <= i + 1 || (closed_ && i == 0 && j == segments - 1)) continue;
-              if (segments_cross(p0, p1, snaxels_[j].position, snaxels_[next(j)].position, nrm)) {
-                cut_a = i;
-                cut_b = j;
-                break;
-              }
-            }
-          }
+    for (int k = 0; k < segments; ++k) {
+      const int i = order[k];
+      for (int m = k + 1; m < segments && boxes[order[m]].min()(axis) <= boxes[i].max()(axis); ++m) {
+        const int a = std::min(i, order[m]), b = std::max(i, order[m]);
+        if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) continue;  // neighbours share a snaxel
+        if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) continue;
+        if (!boxes[a].intersects(boxes[b])) continue;
+        if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
+                           snaxels_[next(b)].position, normal(mesh_, snaxels_[a].point))) {
+          cut_a = a;
+          cut_b = b;
+        }
+      }
     }
     if (cut_a < 0) break;
     // Segments a and b cross: the loop is snaxels a+1 .. b (inner arc) or the
-    // rest (outer arc). Keep the longer arc; open snakes keep their ends.
-    const int inner = cut_b - cut_a;
-    const int outer = n - inner;
+    // rest (outer arc). Keep the arc enclosing the larger area (a wrinkled
+    // sliver can hold more snaxels than the real outline); open snakes keep
+    // their ends.
+    auto arc_area = [&](int first, int count) {
+      // |vector area| of the arc closed by a straight chord.
+      Vec3 twice_area = Vec3::Zero();
+      for (int k = 0; k < count; ++k)
+        twice_area += snaxels_[(first + k) % n].position.cross(snaxels_[(first + (k + 1) % count) % n].position);
+      return twice_area.norm();
+    };
+    const int inner_count = cut_b - cut_a;
+    const bool keep_outer = !closed_ || arc_area(cut_a + 1, inner_count) <= arc_area(cut_b + 1, n - inner_count);
     std::vector<Snaxel> kept;
-    if (!closed_ || inner <= outer) {
+    if (keep_outer) {
       for (int i = 0; i <= cut_a; ++i) kept.push_back(snaxels_[i]);
       for (int i = cut_b + 1; i < n; ++i) kept.push_back(snaxels_[i]);
     } else {

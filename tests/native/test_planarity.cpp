@@ -212,6 +212,11 @@ TEST(Planarity, GeodesicNotEuclideanOnFoldedSheet) {
   EXPECT_GT(ball.size(), 100u);
   for (int w : ball) EXPECT_NEAR(mesh.position(w).z(), 0.0, 1e-12) << "vertex " << w << " is on the other sheet";
   EXPECT_NEAR(field.raw(v), 0.0, 1e-9);  // so the lower sheet stays flat
+  // The Euclidean neighbourhood only takes vertices connected to v inside the
+  // ball, so it does not jump to the other sheet either.
+  rs::PlanarityOptions euclidean{h, 0.0};
+  euclidean.neighbourhood = rs::Neighbourhood::Euclidean;
+  EXPECT_NEAR(rs::PlanarityField(mesh, euclidean).raw(v), 0.0, 1e-9);
 }
 
 TEST(Planarity, BilateralFilterKeepsNoisyStep) {
@@ -293,6 +298,43 @@ TEST(Planarity, LazyAndCached) {
   // A fresh field gives the same values: the reused scratch arrays leave no residue.
   rs::PlanarityField fresh(mesh, {kH, 0.05});
   for (std::size_t k = query.size(); k-- > 0;) EXPECT_EQ(fresh.filtered(query[k]), first[k]);
+}
+
+TEST(Planarity, ParallelPrefetchGivesTheSerialValues) {
+  Grid g = make_step();
+  rs::Mesh mesh = g.mesh();
+  rs::PlanarityOptions serial_options{kH, 0.05};
+  serial_options.threads = 1;
+  rs::PlanarityOptions parallel_options = serial_options;
+  parallel_options.threads = 2;
+  rs::PlanarityField serial(mesh, serial_options), parallel(mesh, parallel_options);
+  std::vector<int> query;
+  for (int j = 4; j < 26; j += 3)
+    for (int i = 20; i < 40; ++i) query.push_back(g.index(i, j));
+  query.push_back(query.front());  // repeats are fine
+  parallel.prefetch_filtered(query);
+  EXPECT_EQ(parallel.filtered_count(), query.size() - 1);
+  const std::size_t raw_after_prefetch = parallel.raw_count();
+  for (int v : query) {
+    EXPECT_EQ(parallel.filtered(v), serial.filtered(v)) << "vertex " << v;  // bit for bit
+    EXPECT_EQ(parallel.raw(v), serial.raw(v)) << "vertex " << v;
+  }
+  EXPECT_EQ(parallel.raw_count(), raw_after_prefetch);  // nothing was left to compute
+  EXPECT_EQ(parallel.raw_count(), serial.raw_count());
+  EXPECT_THROW(parallel.prefetch_raw({0, -1}), rs::Error);
+}
+
+TEST(Planarity, EuclideanNeighbourhoodKeepsTheSignsAndTheSheets) {
+  Grid g = make_step();
+  rs::Mesh mesh = g.mesh();
+  rs::PlanarityOptions options{kH, 0.0};
+  options.neighbourhood = rs::Neighbourhood::Euclidean;
+  rs::PlanarityField field(mesh, options);
+  for (int j = 8; j <= 22; j += 7) {
+    EXPECT_GT(field.raw(g.index(30, j)), 0.02) << "row " << j;   // foot: concave
+    EXPECT_LT(field.raw(g.index(31, j)), -0.02) << "row " << j;  // top edge: convex
+    EXPECT_NEAR(field.raw(g.index(22, j)), 0.0, 1e-9) << "row " << j;
+  }
 }
 
 TEST(Planarity, Errors) {

@@ -119,6 +119,27 @@ TEST(Snake, RemoveLoopsCutsTheSmallSideOfACrossing) {
   for (int i = 0; i < snake.size(); ++i) EXPECT_NEAR((snake[i].position - Vec3(10, 10, 0)).norm(), 5, 0.1);
 }
 
+TEST(Snake, RemoveLoopsKeepsTheLargerAreaNotTheMoreSnaxels) {
+  // A figure eight: a big lobe of 11 snaxels (radius 8) and a small, densely
+  // sampled lobe of 40 (radius 1.5) joined by two crossing segments, as when
+  // a wrinkled stretch of the snake folds over. The big lobe is the outline.
+  const Mesh mesh = test::plane_mesh(81, 40);
+  const Vec3 c(20, 20, 0), small(29.5, 20, 0);
+  std::vector<SurfacePoint> pts;
+  for (int k = 0; k <= 10; ++k) {
+    const double a = (10 + 34 * k) * M_PI / 180;  // 10 .. 350 degrees, counter-clockwise
+    pts.push_back(point_at(mesh, c + 8 * Vec3(std::cos(a), std::sin(a), 0)));
+  }
+  for (int k = 0; k < 40; ++k) {
+    const double a = M_PI / 2 - M_PI * k / 39;  // top to bottom through the right side
+    pts.push_back(point_at(mesh, small + 1.5 * Vec3(std::cos(a), std::sin(a), 0)));
+  }
+  Snake snake(mesh, pts, true, true);
+  EXPECT_GE(snake.remove_loops(), 40);
+  EXPECT_LE(snake.size(), 11);
+  for (int i = 0; i < snake.size(); ++i) EXPECT_NEAR((snake[i].position - c).norm(), 8, 1e-6) << "snaxel " << i;
+}
+
 TEST(Snake, RemoveLoopsLeavesASimpleCurveAlone) {
   const Mesh mesh = test::plane_mesh(41, 20);
   Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 40), true, true);

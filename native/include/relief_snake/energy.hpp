@@ -28,6 +28,9 @@ class FeatureEnergy {
   /// E_f at x, with q searched along `inward` from x; gamma applied by the caller.
   /// Returns (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma).
   double unscaled(const SurfacePoint& x, const Vec3& inward);
+  /// unscaled() at count points with the same inward direction, into out[k];
+  /// the planarity they need is computed as one parallel batch.
+  void unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out);
   /// The q found by the last unscaled() call (for tests and drawing).
   const SurfacePoint& last_q() const { return last_q_; }
   /// Also penalise P^(x) < P^(q) (returns -(P^(x) - P^(q))^2 there). Not in the paper.
@@ -36,7 +39,8 @@ class FeatureEnergy {
  private:
   PlanarityField& planarity_;
   std::vector<double> distances_;
-  std::vector<SurfacePoint> samples_;
+  std::vector<std::vector<SurfacePoint>> samples_;  // per point of a batch
+  std::vector<int> vertices_;                       // the batch's face corners
   SurfacePoint last_q_;
   bool convex_barrier_ = false;
 };

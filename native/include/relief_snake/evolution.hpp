@@ -32,8 +32,9 @@ struct PhaseOutcome {
   bool collapsed = false;
 };
 
-/// Energy of snaxel i of `snake` if it were at candidate x (without deflation).
-double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, const Vec3& inward, FeatureEnergy& feature,
+/// Energy of snaxel i of `snake` if it were at candidate x (without
+/// deflation), given FeatureEnergy::unscaled() there.
+double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, double feature_unscaled,
                      const PhaseSettings& phase);
 
 /// One greedy iteration; returns the number of snaxels that moved.

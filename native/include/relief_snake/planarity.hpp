@@ -2,6 +2,7 @@
 // Planarity (Section 5.3.1) over geodesic-h neighbourhoods and its bilateral
 // filtering (Eqn. 6, Section 7.2.1), computed lazily: only at the vertices the
 // snake actually reaches, and cached for reuse by later segmentations.
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -10,6 +11,12 @@
 
 namespace relief_snake {
 
+/// Which neighbours of v the plane of P(v) is fitted to.
+enum class Neighbourhood {
+  Geodesic,   ///< within geodesic distance h (the paper): local fast marching
+  Euclidean,  ///< within straight distance h and connected to v inside that ball (not in the paper; ~10x cheaper)
+};
+
 struct PlanarityOptions {
   double radius = 0;          ///< geodesic neighbourhood radius: the step height h
   double sigma_s = 0;         ///< bilateral similarity sigma; <= 0: estimate (see PlanarityField::estimate_sigma_s)
@@ -17,7 +24,13 @@ struct PlanarityOptions {
   /// scanned vertical step of height ~h has no vertices on its wall, so the ball
   /// alone would never see the top from the foot (not in the paper).
   bool include_one_ring = true;
+  Neighbourhood neighbourhood = Neighbourhood::Geodesic;
+  /// Threads for prefetch_*(): 0 = one per hardware thread, 1 = the caller only.
+  /// Results do not depend on it.
+  int threads = 0;
 };
+
+class WorkerPool;
 
 /// Planarity P(v) and filtered planarity P^(v) of a mesh for one radius h.
 ///
@@ -32,15 +45,24 @@ struct PlanarityOptions {
 /// two-ring with weights W_c(|v - v'|) W_s(P(v) - P(v')), sigma_c = half the
 /// largest distance to a two-ring vertex, sigma_s global (see options).
 ///
-/// Values are computed on first use and cached; the object is not thread-safe.
+/// Values are computed on first use and cached. prefetch_*() computes a batch
+/// of missing values on several threads; the object itself must be used from
+/// one thread at a time.
 class PlanarityField {
  public:
   PlanarityField(const Mesh& mesh, const PlanarityOptions& options);
+  ~PlanarityField();
 
   double raw(int v);        ///< P(v)
   double filtered(int v);   ///< P^(v)
   /// P^ interpolated linearly inside the face of p.
   double filtered(const SurfacePoint& p);
+
+  /// Computes and caches P at the given vertices, in parallel.
+  void prefetch_raw(const std::vector<int>& vertices);
+  /// Computes and caches P^ at the given vertices; the P they need (over their
+  /// two-rings) is computed in parallel first.
+  void prefetch_filtered(const std::vector<int>& vertices);
 
   /// The geodesic ball used by raw(v): the vertices within geodesic distance
   /// radius() of v (v excluded; fast-marching distances, not the one-ring
@@ -63,25 +85,34 @@ class PlanarityField {
   std::size_t filtered_count() const { return filtered_count_; }
 
  private:
-  double compute_raw(int v);
+  /// Per-thread scratch of the local fast marching, reused between calls.
+  struct Scratch {
+    std::vector<double> distance;            // +inf = untouched
+    std::vector<char> accepted;              // also the visited mark of two_ring()
+    std::vector<int> touched;                // entries of distance/accepted to reset
+    std::vector<std::pair<double, int>> heap;
+    std::vector<int> ball;                   // accepted vertices, v first
+  };
+  Scratch& scratch(int worker);  // allocates on first use
+  double compute_raw(int v, Scratch& scratch) const;
   double compute_filtered(int v);
   void check_vertex(int v) const;
-  /// Fast marching from v up to radius(); fills ball_ (accepted vertices, v first).
-  void march(int v);
-  void reset_scratch();
+  /// Fast marching from v up to radius(); fills scratch.ball.
+  void march(int v, Scratch& scratch) const;
+  /// Breadth-first search from v through vertices within straight distance radius(); fills scratch.ball.
+  void euclidean_ball(int v, Scratch& scratch) const;
+  static void reset(Scratch& scratch);
+  /// v's two-ring (edge-hop distance 1 and 2, v excluded) into *out.
+  void two_ring(int v, Scratch& scratch, std::vector<int>* out) const;
 
   const Mesh& mesh_;
   PlanarityOptions options_;
   double sigma_s_ = 0;
   std::vector<double> raw_, filtered_;  // NaN = not computed yet
   std::size_t raw_count_ = 0, filtered_count_ = 0;
-  // scratch for the local fast marching, reused between calls
-  std::vector<double> distance_;          // +inf = untouched
-  std::vector<int> touched_;              // vertices whose distance_/accepted_ must be reset
-  std::vector<char> accepted_;
-  std::vector<std::pair<double, int>> heap_;
-  std::vector<int> ball_;
-  std::vector<int> ring_;                 // two-ring scratch for filtered()
+  std::vector<Scratch> scratch_;        // one per worker
+  std::unique_ptr<WorkerPool> pool_;    // created by the first prefetch that needs it
+  std::vector<int> ring_, needed_, batch_;  // scratch for filtered() and prefetch_*()
 };
 
 }  // namespace relief_snake

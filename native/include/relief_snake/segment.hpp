@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "relief_snake/mesh.hpp"
+#include "relief_snake/planarity.hpp"
 #include "relief_snake/surface_point.hpp"
 
 namespace relief_snake {
@@ -29,12 +30,16 @@ struct Options {
   double max_turn_degrees = 160;   ///< snaxels turning more than this are removed
   int lock_interval = 10;          ///< every this many iterations, lock snaxels that moved < 2 tau l
   int max_iterations = 3000;       ///< cap per phase
+  int threads = 0;                 ///< threads for the planarity batches: 0 = all cores, 1 = none; results do not depend on it
 
   // Normalisation of the feature energy (our reading of 7.2.3, see docs/design.md).
   double feature_contrast = 0.25;  ///< planarity contrast, in units of h, that scores E_f = -1 at l = h
   bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
   bool convex_barrier = false;     ///< penalise sitting on the step's top edge (not in the paper)
   bool remove_loops = true;        ///< cut off loops where the snake crosses itself (not in the paper)
+  /// Planarity neighbourhoods (see PlanarityOptions). Changing either recomputes the planarity.
+  Neighbourhood neighbourhood = Neighbourhood::Geodesic;
+  bool planarity_one_ring = true;  ///< the one-ring always counts as neighbours (not in the paper)
 };
 
 enum class Status {
