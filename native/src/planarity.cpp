@@ -70,7 +70,7 @@ double point_source_update(const Vec3& A, const Vec3& B, const Vec3& C, double d
   const double t = sy / (cy + sy);    // where S -> C meets the line AB
   const double xt = sx + t * (cx - sx);
   if (xt < 0 || xt > c) return kInf;  // the ray passes outside the edge
-  const double d = std::hypot(cx - sx, cy + sy);
+  const double d = std::sqrt((cx - sx) * (cx - sx) + (cy + sy) * (cy + sy));  // no overflow risk: mesh-sized values
   if (d < std::max(dA, dB)) return kInf;
   return d;
 }
@@ -166,11 +166,17 @@ void PlanarityField::march(int v, Scratch& s) const {
   // Euclidean h-ball can never enter the ball nor serve as upwind values.
   const Vec3 pv = mesh_.position(v);
   const double h2 = h * h;
-  auto reachable = [&](int u) { return (mesh_.position(u) - pv).squaredNorm() <= h2; };
+  // Raw pointers: the compiler cannot tell that pushing onto the heap leaves
+  // these arrays alone, and would reload them at every access otherwise.
+  double* const dist = distance.data();
+  char* const done = accepted.data();
+  const Vec3* const position = &mesh_.position(0);
+  const int* const corners = mesh_.face_vertices();
+  auto reachable = [&](int u) { return (position[u] - pv).squaredNorm() <= h2; };
   auto offer = [&](int u, double d) {
-    if (!(d <= h) || !(d < distance[u])) return;
-    if (distance[u] == kInf) s.touched.push_back(u);
-    distance[u] = d;
+    if (!(d <= h) || !(d < dist[u])) return;
+    if (dist[u] == kInf) s.touched.push_back(u);
+    dist[u] = d;
     heap.emplace_back(d, u);
     std::push_heap(heap.begin(), heap.end(), later);
   };
@@ -180,32 +186,38 @@ void PlanarityField::march(int v, Scratch& s) const {
     const Entry top = heap.back();
     heap.pop_back();
     const int u = top.second;
-    if (accepted[u] || top.first > distance[u]) continue;  // stale entry
-    accepted[u] = 1;
+    if (done[u] || top.first > dist[u]) continue;  // stale entry
+    done[u] = 1;
     s.ball.push_back(u);
-    const double du = distance[u];
-    const Vec3& pu = mesh_.position(u);
+    const double du = dist[u];
+    const Vec3 pu = position[u];
 
     // Dijkstra edge updates: always available, exact along edges.
-    for (const int* it = mesh_.neighbors_begin(u); it != mesh_.neighbors_end(u); ++it) {
+    for (const int *it = mesh_.neighbors_begin(u), *end = mesh_.neighbors_end(u); it != end; ++it) {
       const int w = *it;
-      if (!accepted[w] && reachable(w)) offer(w, du + (mesh_.position(w) - pu).norm());
+      if (!done[w] && reachable(w)) offer(w, du + (position[w] - pu).norm());
     }
     // Triangle updates through every face with u and one other accepted corner.
-    for (const int* it = mesh_.faces_begin(u); it != mesh_.faces_end(u); ++it) {
-      const int f = *it;
-      int a = -1, b = -1;
-      for (int k = 0; k < 3; ++k) {
-        const int c = mesh_.face_vertex(f, k);
-        if (c == u) continue;
-        (a < 0 ? a : b) = c;
+    for (const int *it = mesh_.faces_begin(u), *end = mesh_.faces_end(u); it != end; ++it) {
+      const int* corner = corners + 3 * *it;
+      // The two corners other than u, in face order.
+      int a, b;
+      if (corner[0] == u) {
+        a = corner[1];
+        b = corner[2];
+      } else if (corner[1] == u) {
+        a = corner[2];
+        b = corner[0];
+      } else {
+        a = corner[0];
+        b = corner[1];
       }
-      if (accepted[a] == accepted[b]) continue;  // need exactly one known corner besides u
-      if (accepted[a]) std::swap(a, b);           // now a is the target, b is known
+      if (done[a] == done[b]) continue;  // need exactly one known corner besides u
+      if (done[a]) std::swap(a, b);      // now a is the target, b is known
       if (!reachable(a)) continue;
-      const Vec3 &pa = mesh_.position(a), &pb = mesh_.position(b);
-      double d = point_source_update(pu, pb, pa, du, distance[b]);
-      if (d == kInf) d = triangle_update(pu, pb, pa, du, distance[b]);
+      const Vec3 &pa = position[a], &pb = position[b];
+      double d = point_source_update(pu, pb, pa, du, dist[b]);
+      if (d == kInf) d = triangle_update(pu, pb, pa, du, dist[b]);
       offer(a, d);
     }
   }

@@ -286,6 +286,7 @@ int Snake::remove_loops() {
   int removed = 0;
   std::vector<int> order;
   std::vector<Eigen::AlignedBox3d> boxes;
+  std::vector<char> dirty;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
     const int segments = closed_ ? n : n - 1;
@@ -304,6 +305,15 @@ int Snake::remove_loops() {
       extent.extend(boxes[i]);
     }
     if (!(longest > 0)) break;
+    // A crossing needs a segment that changed since the last check (every
+    // change to the snake marks the snaxels it touches as moved).
+    dirty.resize(segments);
+    bool any_dirty = false;
+    for (int i = 0; i < segments; ++i) {
+      dirty[i] = snaxels_[i].moved || snaxels_[next(i)].moved;
+      any_dirty = any_dirty || dirty[i];
+    }
+    if (!any_dirty) break;
     const Vec3 margin = Vec3::Constant(0.5 * longest);
     for (Eigen::AlignedBox3d& box : boxes) box = Eigen::AlignedBox3d(box.min() - margin, box.max() + margin);
     int axis = 0;
@@ -320,6 +330,7 @@ int Snake::remove_loops() {
         const int a = std::min(i, order[m]), b = std::max(i, order[m]);
         if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) continue;  // neighbours share a snaxel
         if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) continue;
+        if (!dirty[a] && !dirty[b]) continue;
         if (!boxes[a].intersects(boxes[b])) continue;
         if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
                            snaxels_[next(b)].position, normal(mesh_, snaxels_[a].point))) {

@@ -57,6 +57,8 @@ class Mesh {
   const Vec3& position(int v) const { return positions_[v]; }
   /// Corner k (0..2) of face f, counter-clockwise seen from the normal.
   int face_vertex(int f, int k) const { return face_vertices_[3 * f + k]; }
+  /// All corners, 3 per face (F #F by 3, row-major), for inner loops.
+  const int* face_vertices() const { return face_vertices_.data(); }
   /// Face across the edge opposite corner k of f (that edge joins corners k+1 and k+2), -1 on a boundary.
   int face_neighbor(int f, int k) const { return face_neighbors_[3 * f + k]; }
   const Vec3& face_normal(int f) const { return face_normals_[f]; }

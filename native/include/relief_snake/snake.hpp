@@ -49,9 +49,10 @@ class Snake {
   /// Splits segments longer than 1.5 l and merges those shorter than 0.5 l;
   /// returns the number of snaxels added plus removed.
   int resample(double l);
-  /// Cuts off loops where the snake crosses itself (the shorter side of each
-  /// crossing goes); returns the number of snaxels removed. Not in the paper:
-  /// see Options::remove_loops.
+  /// Cuts off loops where the snake crosses itself (the side enclosing the
+  /// smaller area goes); returns the number of snaxels removed. Only segments
+  /// with a moved end are checked against the others, so the snake must have
+  /// had no crossing at the previous call. Not in the paper: see Options::remove_loops.
   int remove_loops();
   /// Resamples every segment to spacing ~l by walking between consecutive snaxels
   /// (used when the refinement phase starts with a shorter l).
