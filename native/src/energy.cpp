@@ -50,6 +50,26 @@ double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
   return value;
 }
 
+bool FeatureEnergy::exploring() const { return planarity_.raw_count() != mark_; }
+
+void FeatureEnergy::mark() { mark_ = planarity_.raw_count(); }
+
+void FeatureEnergy::prefetch(const std::vector<SurfacePoint>& points, const std::vector<Vec3>& inward) {
+  const Mesh& mesh = planarity_.mesh();
+  if (samples_.empty()) samples_.resize(1);
+  vertices_.clear();
+  auto corners = [&](const SurfacePoint& p) {
+    if (!p.valid() || p.face >= mesh.n_faces()) return;
+    for (int k = 0; k < 3; ++k) vertices_.push_back(mesh.face_vertex(p.face, k));
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    corners(points[i]);
+    walk_sampled(mesh, points[i], inward[i], distances_, &samples_[0]);
+    for (const SurfacePoint& q : samples_[0]) corners(q);
+  }
+  planarity_.prefetch_filtered(vertices_);
+}
+
 void FeatureEnergy::unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out) {
   const Mesh& mesh = planarity_.mesh();
   if (static_cast<int>(samples_.size()) < count) samples_.resize(count);

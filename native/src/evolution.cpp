@@ -26,14 +26,36 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
   const int n = snake.size();
   std::vector<char> moved_before(n);
   for (int i = 0; i < n; ++i) moved_before[i] = snake[i].moved;
+  auto evaluated = [&](int i) {
+    // If it and its neighbours stood still last time, its energies are unchanged.
+    const int ip = snake.prev(i), in = snake.next(i);
+    return !snake[i].locked &&
+           (moved_before[i] || (ip >= 0 && moved_before[ip]) || (in >= 0 && moved_before[in]));
+  };
+  // While the snake is entering new territory (planarity was computed since
+  // the last iteration began), compute what this one will need as one parallel batch
+  // first. The candidates are within tau l of the snaxels, so their q samples
+  // fall mostly on the same faces.
+  const bool exploring = feature.exploring();
+  feature.mark();
+  if (phase.w_f != 0 && phase.gamma != 0 && exploring) {
+    std::vector<SurfacePoint> points;
+    std::vector<Vec3> inwards;
+    for (int i = 0; i < n; ++i) {
+      if (!evaluated(i) || snake.is_end(i)) continue;
+      const Vec3 inward = snake.inward(i);
+      if (inward.isZero()) continue;
+      points.push_back(snake[i].point);
+      inwards.push_back(inward);
+    }
+    feature.prefetch(points, inwards);
+  }
   int moved = 0;
   for (int i = 0; i < n; ++i) {
     Snaxel& s = snake[i];
+    const bool evaluate = evaluated(i);
     s.moved = false;
-    if (s.locked) continue;
-    const int ip = snake.prev(i), in = snake.next(i);
-    // If it and its neighbours stood still last time, its energies are unchanged.
-    if (!moved_before[i] && (ip < 0 || !moved_before[ip]) && (in < 0 || !moved_before[in])) continue;
+    if (!evaluate) continue;
 
     const Vec3 inward = snake.inward(i);
     if (inward.isZero()) continue;

@@ -167,6 +167,10 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   param.sigma_s = planarity.sigma_s();
   {
     // sigma of Eqn. 9: spread of P^ along the initial contour, on the background.
+    std::vector<int> corners;
+    for (const SurfacePoint& p : start)
+      for (int k = 0; k < 3; ++k) corners.push_back(mesh.face_vertex(p.face, k));
+    planarity.prefetch_filtered(corners);  // one parallel batch
     double sum = 0, sum2 = 0;
     for (const SurfacePoint& p : start) {
       const double v = planarity.filtered(p);

@@ -31,6 +31,14 @@ class FeatureEnergy {
   /// unscaled() at count points with the same inward direction, into out[k];
   /// the planarity they need is computed as one parallel batch.
   void unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out);
+  /// Computes, as one parallel batch, the planarity unscaled() will need at
+  /// and around these points (their corners and their q samples along
+  /// inward[k]). Pure speed-up: values do not depend on it.
+  void prefetch(const std::vector<SurfacePoint>& points, const std::vector<Vec3>& inward);
+  /// True if planarity had to be computed since the last mark(): the snake is
+  /// in new territory, and prefetch() pays off.
+  bool exploring() const;
+  void mark();
   /// The q found by the last unscaled() call (for tests and drawing).
   const SurfacePoint& last_q() const { return last_q_; }
   /// Also penalise P^(x) < P^(q) (returns -(P^(x) - P^(q))^2 there). Not in the paper.
@@ -43,6 +51,7 @@ class FeatureEnergy {
   std::vector<int> vertices_;                       // the batch's face corners
   SurfacePoint last_q_;
   bool convex_barrier_ = false;
+  std::size_t mark_ = 0;  // planarity raw_count() at the last mark()
 };
 
 }  // namespace relief_snake
