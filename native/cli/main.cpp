@@ -6,6 +6,7 @@
 //
 // Exit codes: 0 success, 1 bad input or failed segmentation, 2 usage error.
 // Every error is exactly one line on stderr: "relief-snake: <message>".
+#include <algorithm>
 #include <chrono>
 #include <cerrno>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <string>
@@ -47,6 +49,7 @@ const char* kUsage =
     "  --open                 open contour that ends on the mesh boundary\n"
     "  --relief-side left|right  with --open: side of the relief along the pick order (default left)\n"
     "  --max-iterations N     iteration cap per phase (default 3000)\n"
+    "  --option NAME=VALUE    set an advanced option (repeatable; see 'advanced options' below)\n"
     "  --out FILE             write the JSON result to FILE instead of stdout\n"
     "  --quiet                no progress on stderr\n"
     "measure: straight-line distance between vertices I and J (to estimate H).\n"
@@ -58,6 +61,118 @@ const char* kUsage =
 struct UsageError : std::runtime_error {
   explicit UsageError(const std::string& message) : std::runtime_error(message) {}
 };
+
+double parse_number(const std::string& text, const std::string& what);
+
+// --- advanced options (--option NAME=VALUE) ------------------------------------
+// One row per field of rs::Options that experiments and the benchmark may change:
+// a new option is one more row. Each row parses and range-checks its value (bad
+// value: UsageError, exit 2) and reports the value used (JSON "parameters").
+
+struct AdvancedOption {
+  const char* name;
+  const char* range;  ///< what the value must be, for messages and --help
+  std::function<void(rs::Options&, const std::string&)> set;
+  std::function<json(const rs::Options&)> get;
+};
+
+AdvancedOption number_option(const char* name, double rs::Options::*field, const char* range,
+                             bool (*valid)(double)) {
+  return {name, range,
+          [=](rs::Options& o, const std::string& text) {
+            const double x = parse_number(text, std::string("--option ") + name);
+            if (!valid(x)) throw UsageError(std::string("--option ") + name + " must be " + range + ", got '" + text + "'");
+            o.*field = x;
+          },
+          [=](const rs::Options& o) { return json(o.*field); }};
+}
+
+AdvancedOption integer_option(const char* name, int rs::Options::*field, const char* range, bool (*valid)(double)) {
+  return {name, range,
+          [=](rs::Options& o, const std::string& text) {
+            const std::string what = std::string("--option ") + name;
+            errno = 0;
+            char* end = nullptr;
+            const long long n = std::strtoll(text.c_str(), &end, 10);
+            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || n > 100000000 ||
+                !valid(static_cast<double>(n)))
+              throw UsageError(what + " must be " + range + ", got '" + text + "'");
+            o.*field = static_cast<int>(n);
+          },
+          [=](const rs::Options& o) { return json(o.*field); }};
+}
+
+AdvancedOption bool_option(const char* name, bool rs::Options::*field) {
+  return {name, "0, 1, true or false",
+          [=](rs::Options& o, const std::string& text) {
+            if (text == "1" || text == "true") o.*field = true;
+            else if (text == "0" || text == "false") o.*field = false;
+            else throw UsageError(std::string("--option ") + name + " must be 0, 1, true or false, got '" + text + "'");
+          },
+          [=](const rs::Options& o) { return json(o.*field); }};
+}
+
+AdvancedOption neighbourhood_option(const char* name, rs::Neighbourhood rs::Options::*field) {
+  return {name, "geodesic or euclidean",
+          [=](rs::Options& o, const std::string& text) {
+            if (text == "geodesic") o.*field = rs::Neighbourhood::Geodesic;
+            else if (text == "euclidean") o.*field = rs::Neighbourhood::Euclidean;
+            else throw UsageError(std::string("--option ") + name + " must be geodesic or euclidean, got '" + text + "'");
+          },
+          [=](const rs::Options& o) { return json(o.*field == rs::Neighbourhood::Geodesic ? "geodesic" : "euclidean"); }};
+}
+
+const std::vector<AdvancedOption>& advanced_options() {
+  static const std::vector<AdvancedOption> table = {
+      number_option("tau", &rs::Options::tau, "in (0, 1)", [](double x) { return x > 0 && x < 1; }),
+      number_option("epsilon", &rs::Options::epsilon, "in [0, 1)", [](double x) { return x >= 0 && x < 1; }),
+      integer_option("q_samples", &rs::Options::q_samples, "a whole number >= 1", [](double x) { return x >= 1; }),
+      number_option("max_turn_degrees", &rs::Options::max_turn_degrees, "in (0, 180]",
+                    [](double x) { return x > 0 && x <= 180; }),
+      integer_option("lock_interval", &rs::Options::lock_interval, "a whole number >= 1",
+                     [](double x) { return x >= 1; }),
+      number_option("feature_contrast", &rs::Options::feature_contrast, "> 0", [](double x) { return x > 0; }),
+      bool_option("scale_feature_with_spacing", &rs::Options::scale_feature_with_spacing),
+      bool_option("convex_barrier", &rs::Options::convex_barrier),
+      bool_option("remove_loops", &rs::Options::remove_loops),
+      neighbourhood_option("neighbourhood", &rs::Options::neighbourhood),
+      bool_option("planarity_one_ring", &rs::Options::planarity_one_ring),
+      integer_option("threads", &rs::Options::threads, "a whole number >= 0 (0: all cores)",
+                     [](double x) { return x >= 0 && x <= 4096; }),
+  };
+  return table;
+}
+
+std::string advanced_option_names() {
+  std::string names;
+  for (const AdvancedOption& a : advanced_options()) names += (names.empty() ? "" : ", ") + std::string(a.name);
+  return names;
+}
+
+std::string advanced_options_help() {
+  std::string text = "advanced options of segment (--option NAME=VALUE, repeatable; docs/design.md says which depart from the paper):\n";
+  const rs::Options defaults;
+  for (const AdvancedOption& a : advanced_options()) {
+    std::string line = std::string("  ") + a.name;
+    line.resize(std::max<std::size_t>(line.size() + 1, 30), ' ');
+    text += line + a.range + " (default " + a.get(defaults).dump() + ")\n";
+  }
+  return text;
+}
+
+/// Applies "NAME=VALUE" to the options.
+void set_advanced_option(rs::Options& options, const std::string& assignment) {
+  const std::size_t eq = assignment.find('=');
+  const std::string name = assignment.substr(0, eq);
+  if (eq == std::string::npos || name.empty())
+    throw UsageError("--option needs NAME=VALUE, got '" + assignment + "'; valid names: " + advanced_option_names());
+  for (const AdvancedOption& a : advanced_options())
+    if (name == a.name) {
+      a.set(options, assignment.substr(eq + 1));
+      return;
+    }
+  throw UsageError("unknown --option '" + name + "'; valid names: " + advanced_option_names());
+}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -226,6 +341,8 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       const std::int64_t n = parse_index(take_value(), "--max-iterations");
       if (n < 1 || n > 100000000) throw UsageError("--max-iterations must be between 1 and 100000000");
       a.options.max_iterations = static_cast<int>(n);
+    } else if (name == "--option") {
+      set_advanced_option(a.options, take_value());
     } else if (name == "--out" || name == "-o") {
       a.out_path = take_value();
       if (a.out_path.empty()) throw UsageError("--out needs a file name");
@@ -297,12 +414,8 @@ int run_segment(const std::vector<std::string>& args) {
                      {"open", !o.closed},
                      {"relief_side", o.relief_side == rs::ReliefSide::Left ? "left" : "right"},
                      {"picks", a.picks},
-                     {"max_iterations", o.max_iterations},
-                     {"tau", o.tau},
-                     {"epsilon", o.epsilon},
-                     {"q_samples", o.q_samples},
-                     {"max_turn_degrees", o.max_turn_degrees},
-                     {"lock_interval", o.lock_interval}};
+                     {"max_iterations", o.max_iterations}};
+  for (const AdvancedOption& option : advanced_options()) parameters[option.name] = option.get(o);
   for (const auto& [name, value] : d.named_values()) parameters[name] = value;
   const json out = {{"status", rs::to_string(result.status)},
                     {"closed", result.closed},
@@ -355,15 +468,16 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
+    const std::string help = std::string(kUsage) + "\n" + advanced_options_help();
     const std::string command = args[0];
     if (command == "--help" || command == "-h" || command == "help") {
-      std::cout << kUsage;
+      std::cout << help;
       return 0;
     }
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     for (const std::string& arg : rest)
       if (arg == "--help") {
-        std::cout << kUsage;
+        std::cout << help;
         return 0;
       }
     if (command == "segment") return run_segment(rest);

@@ -160,3 +160,101 @@ def test_segment_synthetic_scan(cli, build_dir, tmp_path):
     recall = len(found & true) / len(true)
     assert precision >= 0.9, (precision, recall)
     assert recall >= 0.8, (precision, recall)
+
+
+ADVANCED_OPTIONS = ["tau", "epsilon", "q_samples", "max_turn_degrees", "lock_interval", "feature_contrast",
+                    "scale_feature_with_spacing", "convex_barrier", "remove_loops", "neighbourhood",
+                    "planarity_one_ring", "threads"]
+
+
+def test_help_lists_the_advanced_options(cli):
+    r = run(cli, "--help")
+    assert r.returncode == 0
+    assert "--option NAME=VALUE" in r.stdout
+    for name in ADVANCED_OPTIONS:
+        assert f"\n  {name} " in r.stdout, name
+
+
+@pytest.mark.parametrize(
+    "option, words",
+    [
+        ("bogus=1", ["'bogus'", "valid names", *ADVANCED_OPTIONS]),
+        ("remove_loops", ["NAME=VALUE", "valid names", "tau"]),
+        ("=1", ["NAME=VALUE", "valid names"]),
+        ("tau=abc", ["tau", "'abc'"]),
+        ("tau=1.5", ["tau", "(0, 1)", "'1.5'"]),
+        ("epsilon=-0.1", ["epsilon", "[0, 1)"]),
+        ("q_samples=2.5", ["q_samples", "whole number"]),
+        ("q_samples=0", ["q_samples", ">= 1"]),
+        ("lock_interval=x", ["lock_interval"]),
+        ("max_turn_degrees=181", ["max_turn_degrees", "(0, 180]"]),
+        ("feature_contrast=0", ["feature_contrast", "> 0"]),
+        ("remove_loops=maybe", ["remove_loops", "0, 1, true or false", "'maybe'"]),
+        ("convex_barrier=", ["convex_barrier"]),
+        ("neighbourhood=manhattan", ["neighbourhood", "geodesic or euclidean", "'manhattan'"]),
+        ("planarity_one_ring=2", ["planarity_one_ring"]),
+        ("threads=-1", ["threads", ">= 0"]),
+    ],
+)
+def test_bad_advanced_option_is_a_usage_error(cli, grid_obj, option, words):
+    # Rejected while parsing the command line: before the mesh is read (exit 2, one line).
+    line = assert_one_error_line(run(cli, "segment", grid_obj, "--picks", "0,1,4", "--step-height", "1",
+                                     "--option", option), 2)
+    for w in words:
+        assert w in line, line
+
+
+def test_advanced_options_reach_the_engine_and_the_report(cli, build_dir, tmp_path):
+    make_scan = build_dir / "make-scan"
+    if not make_scan.is_file():
+        pytest.fail(f"{make_scan} not found: build the make-scan target")
+    prefix = tmp_path / "disk"
+    r = subprocess.run([str(make_scan), "--shape", "disk", "--triangles", "20000", "--step", "blended",
+                        "--out", str(prefix)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    truth = json.loads(Path(f"{prefix}.truth.json").read_text())
+    picks = ",".join(str(p) for p in truth["picks"])
+
+    # Defaults: every advanced option is reported under "parameters".
+    out = tmp_path / "default.json"
+    r = run(cli, "segment", f"{prefix}.ply", "--picks", picks, "--step-height", truth["h"], "--out", out, "--quiet",
+            timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    params = json.loads(out.read_text())["parameters"]
+    assert params["tau"] == 0.2 and params["epsilon"] == 0.2 and params["q_samples"] == 5
+    assert params["max_turn_degrees"] == 160 and params["lock_interval"] == 10
+    assert params["feature_contrast"] == 0.25
+    assert params["scale_feature_with_spacing"] is True and params["convex_barrier"] is False
+    assert params["remove_loops"] is True
+    assert params["neighbourhood"] == "geodesic" and params["planarity_one_ring"] is True and params["threads"] == 0
+
+    # Set: repeated --option, both spellings, the last one of a name wins. (The iteration cap only
+    # bounds the run time; whether these values segment well is the benchmark's business.)
+    out = tmp_path / "set.json"
+    r = run(cli, "segment", f"{prefix}.ply", "--picks", picks, "--step-height", truth["h"], "--out", out, "--quiet",
+            "--max-iterations", "300",
+            "--option", "remove_loops=0", "--option", "remove_loops=1", "--option=tau=0.25",
+            "--option", "q_samples=7", "--option", "lock_interval=12", "--option", "convex_barrier=true",
+            "--option", "epsilon=0.15", "--option", "max_turn_degrees=150", "--option", "feature_contrast=0.3",
+            "--option", "scale_feature_with_spacing=true", "--option", "neighbourhood=euclidean",
+            "--option", "threads=1", timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    result = json.loads(out.read_text())
+    params = result["parameters"]
+    assert params["remove_loops"] is True and params["convex_barrier"] is True
+    assert params["tau"] == 0.25 and params["q_samples"] == 7 and params["lock_interval"] == 12
+    assert params["epsilon"] == 0.15 and params["max_turn_degrees"] == 150 and params["feature_contrast"] == 0.3
+    assert params["neighbourhood"] == "euclidean" and params["threads"] == 1
+    assert result["status"] in ("converged", "iteration_cap")
+    assert result["relief_vertices"]
+
+    # Booleans switched off, 0/false spellings (a few iterations: this combination need not settle).
+    out = tmp_path / "off.json"
+    r = run(cli, "segment", f"{prefix}.ply", "--picks", picks, "--step-height", truth["h"], "--out", out, "--quiet",
+            "--max-iterations", "20", "--option", "remove_loops=false", "--option", "scale_feature_with_spacing=0",
+            "--option", "planarity_one_ring=0",
+            timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    params = json.loads(out.read_text())["parameters"]
+    assert params["remove_loops"] is False and params["scale_feature_with_spacing"] is False
+    assert params["planarity_one_ring"] is False
