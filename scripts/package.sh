@@ -5,12 +5,20 @@
 #   dist/relief_snake-<version>-linux_x64.zip  Blender 4.2+ extension: blender_manifest.toml,
 #       the add-on's files and wheels/relief_snake_core-*.whl, built and validated by Blender's
 #       own extension tool (blender_ext.py from the bpy 4.2 wheel in .venv-bpy).
+# The compiled module comes from the CMake build in $BUILD_DIR (default build/), the one
+# `make build` and `make test` use: configured like `make build` when it does not exist yet,
+# then only the relief_snake_core target is brought up to date, and scripts/build-wheel.sh
+# --from-build wraps it into the wheel (no second compile of the engine; `make test` packages
+# and tests what it just built). WHEEL_FROM=scikit-build builds the wheel with scikit-build-core
+# in build-wheel/ instead (as `make wheel` does).
 # The add-on imports the module as `from . import relief_snake_core` (legacy zip) and falls
 # back to `import relief_snake_core` (the extension's wheel).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PYTHON=${PYTHON:-python3}
+BUILD_DIR=${BUILD_DIR:-build}
+WHEEL_FROM=${WHEEL_FROM:-build}
 DIST=${DIST:-dist}
 STAGE=${STAGE:-build-package}
 ADDON=addon/relief_snake
@@ -28,7 +36,24 @@ if [ ! -f "$ADDON/__init__.py" ]; then
 fi
 
 # --- the wheel -------------------------------------------------------------
-WHEEL_DIR="$DIST" PYTHON="$PYTHON" scripts/build-wheel.sh
+case "$WHEEL_FROM" in
+  build)
+    scripts/install-deps.sh
+    if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+      echo "package: configuring $BUILD_DIR (as make build does)" >&2
+      cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE="$(command -v "$PYTHON")" >/dev/null
+    fi
+    cmake --build "$BUILD_DIR" --target relief_snake_core -j "${JOBS:-$(nproc)}"
+    WHEEL_DIR="$DIST" PYTHON="$PYTHON" scripts/build-wheel.sh --from-build "$BUILD_DIR"
+    ;;
+  scikit-build)
+    WHEEL_DIR="$DIST" PYTHON="$PYTHON" scripts/build-wheel.sh
+    ;;
+  *)
+    echo "package: WHEEL_FROM must be build or scikit-build, not '$WHEEL_FROM'" >&2
+    exit 1
+    ;;
+esac
 wheel=$(ls "$DIST"/relief_snake_core-"$version"-*.whl)
 wheel_name=$(basename "$wheel")
 if ! grep -q "\"./wheels/$wheel_name\"" blender_manifest.toml; then

@@ -6,7 +6,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 scripts/install-blender.sh >/dev/null
-export RELIEF_SNAKE_BUILD_DIR=${RELIEF_SNAKE_BUILD_DIR:-$PWD/${BUILD_DIR:-build}}
+build_dir=${BUILD_DIR:-build}
+case "$build_dir" in /*) ;; *) build_dir=$PWD/$build_dir ;; esac  # BUILD_DIR may be absolute
+export RELIEF_SNAKE_BUILD_DIR=${RELIEF_SNAKE_BUILD_DIR:-$build_dir}
 unset RELIEF_SNAKE_FAKE_CORE  # the development-only fake engine never counts
 PYTHON=${PYTHON:-python3}
 VENV=${VENV_BPY:-.venv-bpy}

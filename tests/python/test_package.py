@@ -1,14 +1,18 @@
 """The packages made by `make package`: unpack both zips and import the module from them.
 
-Skipped when dist/ (or $RELIEF_SNAKE_DIST) holds no package, i.e. `make package` was not run.
-CI: `make package && python3 -m pytest tests/python/test_package.py`.
+Skipped when dist/ (or $RELIEF_SNAKE_DIST) holds no package, i.e. `make package` was not run,
+and the Blender installs are skipped when a Blender is missing -- except with
+RELIEF_SNAKE_REQUIRE_PACKAGES=1, where each of those is a failure. `make test` (CI) builds the
+packages into $(BUILD_DIR)/dist and runs this file that way (the Makefile's test-package).
 
 Each import runs in a subprocess (a second copy of the same extension module cannot be
 loaded into this process) and reads /proc/self/maps to prove that libOpenMeshCore comes
 from the package, not from the system's libopenmesh. When Blender 3.4 (`blender`) and
 bpy 4.2 (.venv-bpy) are present, the zips are also installed and enabled in them.
 """
+import base64
 import glob
+import hashlib
 import os
 import shutil
 import subprocess
@@ -32,8 +36,22 @@ VERSION = _version()
 LEGACY = os.path.join(DIST, "relief_snake-%s-legacy.zip" % VERSION)
 EXTENSION = os.path.join(DIST, "relief_snake-%s-linux_x64.zip" % VERSION)
 
-pytestmark = pytest.mark.skipif(not (os.path.exists(LEGACY) or os.path.exists(EXTENSION)),
-                                reason="no packages in %s: run `make package`" % DIST)
+# `make test` sets it: there, a package or Blender that is missing fails instead of skipping.
+REQUIRED = os.environ.get("RELIEF_SNAKE_REQUIRE_PACKAGES") == "1"
+
+
+def need(condition, reason):
+    """Skip the test when `condition` is false -- or fail it when packages are required."""
+    if not condition:
+        if REQUIRED:
+            pytest.fail("%s (RELIEF_SNAKE_REQUIRE_PACKAGES=1: nothing may be skipped)" % reason)
+        pytest.skip(reason)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def packages_present():  # module scope and autouse: before the zips' fixtures
+    need(os.path.exists(LEGACY) or os.path.exists(EXTENSION),
+         "no packages in %s: run `make package`" % DIST)
 
 # Imports the module from a folder, uses it, and reports where the module and libOpenMeshCore came from.
 IMPORT_CHECK = textwrap.dedent("""
@@ -104,8 +122,8 @@ def test_legacy_zip_module_imports_with_bundled_openmesh(legacy):
     assert_self_contained(str(out / "relief_snake"))
 
 
-@pytest.mark.skipif(shutil.which("blender") is None, reason="Blender 3.4 (blender) not installed")
 def test_legacy_zip_installs_in_blender(tmp_path):
+    need(shutil.which("blender") is not None, "Blender 3.4 (blender) not installed")
     script = tmp_path / "install.py"
     script.write_text(textwrap.dedent("""
         import sys, bpy, addon_utils
@@ -167,17 +185,49 @@ def test_extension_wheel_imports_with_bundled_openmesh(extension, tmp_path):
     assert_self_contained(str(site))
 
 
-@pytest.mark.skipif(blender_ext_script() is None, reason="bpy 4.2 (.venv-bpy) not installed")
+def test_extension_wheel_is_a_consistent_wheel(extension):
+    # The wheel is assembled by scripts/build-wheel.sh (--from-build) or scikit-build-core: either
+    # way its RECORD must list every file with the right hash and size, and its tag and metadata
+    # must be what the manifest and Blender 4.2's Python (CPython 3.11, Linux x86-64) expect.
+    out, _ = extension
+    (wheel,) = glob.glob(str(out / "wheels" / "*.whl"))
+    info = "relief_snake_core-%s.dist-info" % VERSION
+    with zipfile.ZipFile(wheel) as z:
+        names = set(z.namelist())
+        record = z.read(info + "/RECORD").decode().splitlines()
+        entries = {}
+        for line in filter(None, record):
+            path, digest, size = line.rsplit(",", 2)
+            entries[path] = (digest, size)
+        assert set(entries) == names, set(entries) ^ names
+        for path, (digest, size) in entries.items():
+            if path == info + "/RECORD":
+                assert (digest, size) == ("", "")
+                continue
+            data = z.read(path)
+            algo, _, want = digest.partition("=")
+            assert algo == "sha256" and size == str(len(data)), path
+            got = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+            assert got == want, "RECORD hash of %s" % path
+        wheel_meta = z.read(info + "/WHEEL").decode()
+        metadata = z.read(info + "/METADATA").decode()
+    assert "Root-Is-Purelib: false" in wheel_meta
+    assert "Tag: cp311-cp311-linux_x86_64" in wheel_meta.splitlines()
+    assert "Name: relief_snake_core" in metadata.splitlines()
+    assert "Version: %s" % VERSION in metadata.splitlines()
+    assert "Requires-Python: >=3.11" in metadata.splitlines()
+
+
 def test_extension_passes_blenders_validation():
+    need(blender_ext_script() is not None, "bpy 4.2 (.venv-bpy) not installed")
     out = subprocess.run([sys.executable, blender_ext_script(), "validate", EXTENSION], capture_output=True,
                          text=True, timeout=120)
     assert out.returncode == 0, out.stdout + out.stderr
     assert "Success" in out.stdout
 
 
-@pytest.mark.skipif(not os.path.exists(os.path.join(ROOT, ".venv-bpy", "bin", "python")),
-                    reason="bpy 4.2 (.venv-bpy) not installed")
 def test_extension_installs_in_bpy_42(tmp_path):
+    need(os.path.exists(os.path.join(ROOT, ".venv-bpy", "bin", "python")), "bpy 4.2 (.venv-bpy) not installed")
     script = tmp_path / "install.py"
     script.write_text(textwrap.dedent("""
         import sys, bpy
