@@ -4,10 +4,10 @@
     .venv-bpy/bin/python tests/blender/run_tests.py
 
 It enables the add-on from addon/, puts the built native module (build/relief_snake_core*.so,
-or $RELIEF_SNAKE_BUILD_DIR) on sys.path, writes a synthetic scan with build/make-scan and
-runs tests/blender/test_*.py. Exit status is non-zero when anything fails, when a test is
-skipped, or when bpy, the native module or make-scan is missing: a suite that did not run
-is a failure.
+or $RELIEF_SNAKE_BUILD_DIR) on sys.path, writes two synthetic scans with build/make-scan (a
+closed duck relief and an open relief cut by the mesh border) and runs tests/blender/test_*.py.
+Exit status is non-zero when anything fails, when a test is skipped, or when bpy, the native
+module or make-scan is missing: a suite that did not run is a failure.
 
 Development only: RELIEF_SNAKE_FAKE_CORE=1 uses tests/blender/dev/ (a fake engine and a
 Python-made disk scan) and always exits non-zero, so it can never pass for the real thing.
@@ -61,6 +61,21 @@ def make_scan(out_dir):
         return prefix, json.load(f)
 
 
+def make_open_scan(out_dir):
+    """The open-contour scan (a relief cut by the mesh's right edge, picks from border to border,
+    the relief on their left; the same case as tests/native/test_segment.cpp's open_relief).
+    Returns (prefix, truth dict), or None with the fake engine (it has no open scan)."""
+    if FAKE:
+        return None
+    prefix = os.path.join(out_dir, "open")
+    cmd = [os.path.join(BUILD, "make-scan"), "--shape", "open", "--background", "plane", "--triangles",
+           os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "60000"), "--step", "blended", "--seed", "1",
+           "--out", prefix]
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    with open(prefix + ".truth.json") as f:
+        return prefix, json.load(f)
+
+
 def main():
     try:
         import bpy
@@ -95,9 +110,10 @@ def main():
 
     tmp = tempfile.mkdtemp(prefix="relief-snake-blender-")
     prefix, truth = make_scan(tmp)
+    open_scan = make_open_scan(tmp)
     sys.path.insert(0, HERE)
     import test_addon
-    test_addon.configure(prefix, truth, fake=FAKE)
+    test_addon.configure(prefix, truth, fake=FAKE, open_scan=open_scan)
 
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()

@@ -14,10 +14,16 @@ import plyio
 _CFG = {}
 
 
-def configure(prefix, truth, fake=False):
-    """Called by run_tests.py: the scan files and their ground truth."""
+def configure(prefix, truth, fake=False, open_scan=None):
+    """Called by run_tests.py: the scan files and their ground truth; open_scan is (prefix, truth)
+    of the open-contour scan, or None (fake engine only)."""
     vertices, faces = plyio.read_ply(prefix + ".ply")
-    _CFG.update(prefix=prefix, truth=truth, vertices=vertices, faces=faces, fake=fake)
+    _CFG.update(prefix=prefix, truth=truth, vertices=vertices, faces=faces, fake=fake, open=None)
+    if open_scan is not None:
+        open_prefix, open_truth = open_scan
+        open_vertices, open_faces = plyio.read_ply(open_prefix + ".ply")
+        _CFG["open"] = {"prefix": open_prefix, "truth": open_truth, "vertices": open_vertices,
+                        "faces": open_faces}
 
 
 def addon():
@@ -39,9 +45,11 @@ def clear_scene():
     bpy.context.scene.relief_snake.last_phases = ""
 
 
-def make_scan_object(name="Scan"):
+def make_scan_object(name="Scan", scan=None):
+    """A mesh object from the duck scan, or from `scan` (a dict with vertices and faces)."""
+    scan = scan or _CFG
     mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata(_CFG["vertices"], [], _CFG["faces"])
+    mesh.from_pydata(scan["vertices"], [], scan["faces"])
     mesh.update()
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
@@ -119,9 +127,10 @@ def boundary_points(truth):
     return b
 
 
-def distances_to(points, targets):
-    """For each point, the distance to the nearest target point (uniform grid hashing)."""
-    cell = max(truth_edge() * 2, 1e-9)
+def distances_to(points, targets, edge=None):
+    """For each point, the distance to the nearest target point (uniform grid hashing with cells
+    of two average edges: `edge`, by default the duck scan's)."""
+    cell = max((edge or truth_edge()) * 2, 1e-9)
     grid = {}
     for t in targets:
         grid.setdefault(tuple(int(math.floor(c / cell)) for c in t), []).append(t)
@@ -162,7 +171,7 @@ class AddonTestCase(unittest.TestCase):
     def tearDown(self):
         clear_scene()
 
-    def assertSegmentationMatchesTruth(self, obj, group="Relief"):
+    def assertSegmentationMatchesTruth(self, obj, group="Relief", closed=True):
         members = group_members(obj, group)
         score = iou(members, self.truth["relief_vertices"])
         self.assertGreaterEqual(score, 0.9, "IoU %.3f against the ground truth" % score)
@@ -173,13 +182,13 @@ class AddonTestCase(unittest.TestCase):
         self.assertEqual(len(curve.data.splines), 1)
         spline = curve.data.splines[0]
         self.assertEqual(spline.type, 'POLY')
-        self.assertTrue(spline.use_cyclic_u)
+        self.assertEqual(spline.use_cyclic_u, closed)
         pts = [tuple(p.co)[:3] for p in spline.points]
         if not _CFG["fake"]:
             self.assertGreater(len(pts), len(self.picks))  # the snake refines the pick polygon
-        d = sorted(distances_to(pts, boundary_points(self.truth)))
+        edge = self.truth["average_edge"]
+        d = sorted(distances_to(pts, boundary_points(self.truth), edge))
         median, p90 = d[len(d) // 2], d[int(0.9 * (len(d) - 1))]
-        edge = truth_edge()
         self.assertLess(median, 2 * edge, "contour median distance to the true boundary %.3g" % median)
         self.assertLess(p90, max(4 * edge, 0.5 * self.h), "contour p90 distance %.3g" % p90)
         return members
@@ -467,3 +476,66 @@ class MeasureAndApi(AddonTestCase):
         preview.start()
         self.assertFalse(preview.is_active())
         self.assertIsNone(preview._shader)
+
+
+class OpenContour(AddonTestCase):
+    """An open relief: a disk cut by the mesh's right edge. The picks run from border to border
+    with the relief on their left (truth["relief_side"]); the contour must end on the border and
+    its curve must not be cyclic."""
+
+    def setUp(self):
+        scan = _CFG["open"]
+        if scan is None:
+            self.skipTest("no open scan (fake engine)")  # run_tests.py counts a skip as a failure
+        clear_scene()
+        self.truth = scan["truth"]
+        self.h = float(self.truth["h"])
+        self.picks = list(self.truth["picks"])
+        self.side = self.truth["relief_side"].upper()
+        self.assertFalse(self.truth["picks_closed"])
+        self.assertIn(self.side, ('LEFT', 'RIGHT'))
+        self.other_side = 'RIGHT' if self.side == 'LEFT' else 'LEFT'
+        self.obj = make_scan_object(scan=scan)
+
+    def assertEndsOnTheBorder(self, obj):
+        spline = bpy.data.objects[obj.name + "_ReliefContour"].data.splines[0]
+        ends = [tuple(spline.points[0].co)[:3], tuple(spline.points[-1].co)[:3]]
+        line = self.truth["boundary"][0]
+        truth_ends = [tuple(line[0]), tuple(line[-1])]
+        edge = self.truth["average_edge"]
+        for end in ends:
+            d = min(math.dist(end, t) for t in truth_ends)
+            self.assertLess(d, 2 * edge, "contour end %s is %.3g from the true boundary's ends" % (end, d))
+        # one end at each end of the true boundary, not both at the same one
+        self.assertNotEqual(min(truth_ends, key=lambda t: math.dist(ends[0], t)),
+                            min(truth_ends, key=lambda t: math.dist(ends[1], t)))
+
+    def test_open_contour_segments_the_relief(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h, open_contour=True, relief_side=self.side), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj, closed=False)
+        self.assertEndsOnTheBorder(self.obj)
+        self.assertIn("(open)", bpy.context.scene.relief_snake.last_summary)
+
+    def test_reversed_picks_take_the_other_side(self):
+        # The side is relative to the click order: the same picks clicked backwards put the
+        # relief on the other side.
+        select_vertices(self.obj, self.picks[::-1])
+        self.assertEqual(seg(step_height=self.h, open_contour=True, relief_side=self.other_side), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj, closed=False)
+        self.assertEndsOnTheBorder(self.obj)
+
+    def test_wrong_side_does_not_find_the_relief(self):
+        # Told the relief is on the other side, the snake deflates away from it: either the engine
+        # refuses (and nothing is written) or its region is not the relief.
+        select_vertices(self.obj, self.picks)
+        before = snapshot()
+        try:
+            ret = seg(step_height=self.h, open_contour=True, relief_side=self.other_side)
+        except RuntimeError:
+            self.assertEqual(snapshot(), before)
+            return
+        self.assertEqual(ret, {'FINISHED'})
+        score = iou(group_members(self.obj, "Relief"), self.truth["relief_vertices"])
+        self.assertLess(score, 0.5, "the wrong relief side still gave IoU %.3f" % score)
+
