@@ -844,6 +844,27 @@ void write_truth_json(const Scan& scan, const Picks& picks, const std::string& p
   j["relief_side"] = picks.relief_side == ReliefSide::Left ? "left" : "right";
   j["near_distance"] = picks.near_distance;
   j["far_distance"] = picks.far_distance;
+  if (sp.shape == Shape::Slots) {
+    // Per slot: where it is and the mesh vertices inside it (the background the snake
+    // uncovers if it enters the slot; they are not relief vertices).
+    nlohmann::json slots = nlohmann::json::array();
+    const double depth = sp.slot_depth * sp.h;
+    for (std::size_t k = 0; k + 1 < scan.slots.size(); k += 2) {
+      const double center = scan.slots[k], width = scan.slots[k + 1];
+      std::vector<std::int64_t> inside;
+      for (std::size_t v = 0; v < scan.n_vertices(); ++v) {
+        const double u = scan.UV[2 * v], w = scan.UV[2 * v + 1];
+        if (std::abs(u - center) < 0.5 * width && w > kSlotsHalfV - depth && w < kSlotsHalfV)
+          inside.push_back(static_cast<std::int64_t>(v));
+      }
+      slots.push_back({{"center_u", center},
+                       {"width", width},
+                       {"width_edges", k / 2 < sp.slot_widths.size() ? sp.slot_widths[k / 2] : 0.0},
+                       {"depth", depth},
+                       {"vertices", inside}});
+    }
+    j["slots"] = std::move(slots);
+  }
   j["spec"] = {{"shape", to_string(sp.shape)},      {"background", to_string(sp.background)},
                {"triangles", sp.triangles},         {"h", sp.h},
                {"width", sp.width},                 {"height", sp.height},
