@@ -75,6 +75,7 @@ VARIANTS = [
     ("no-one-ring", ["planarity_one_ring=0"]),
     ("euclidean", ["neighbourhood=euclidean"]),
     ("convex-barrier", ["convex_barrier=1"]),
+    ("exact-q", ["exact_q=1"]),
 ]
 
 

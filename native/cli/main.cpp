@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "relief_snake/error.hpp"
+#include "relief_snake/option_table.hpp"
 #include "relief_snake/mesh.hpp"
 #include "relief_snake/segment.hpp"
 
@@ -62,100 +63,18 @@ struct UsageError : std::runtime_error {
   explicit UsageError(const std::string& message) : std::runtime_error(message) {}
 };
 
-double parse_number(const std::string& text, const std::string& what);
-
 // --- advanced options (--option NAME=VALUE) ------------------------------------
-// One row per field of rs::Options that experiments and the benchmark may change:
-// a new option is one more row. Each row parses and range-checks its value (bad
-// value: UsageError, exit 2) and reports the value used (JSON "parameters").
-
-struct AdvancedOption {
-  const char* name;
-  const char* range;  ///< what the value must be, for messages and --help
-  std::function<void(rs::Options&, const std::string&)> set;
-  std::function<json(const rs::Options&)> get;
-};
-
-AdvancedOption number_option(const char* name, double rs::Options::*field, const char* range,
-                             bool (*valid)(double)) {
-  return {name, range,
-          [=](rs::Options& o, const std::string& text) {
-            const double x = parse_number(text, std::string("--option ") + name);
-            if (!valid(x)) throw UsageError(std::string("--option ") + name + " must be " + range + ", got '" + text + "'");
-            o.*field = x;
-          },
-          [=](const rs::Options& o) { return json(o.*field); }};
-}
-
-AdvancedOption integer_option(const char* name, int rs::Options::*field, const char* range, bool (*valid)(double)) {
-  return {name, range,
-          [=](rs::Options& o, const std::string& text) {
-            const std::string what = std::string("--option ") + name;
-            errno = 0;
-            char* end = nullptr;
-            const long long n = std::strtoll(text.c_str(), &end, 10);
-            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || n > 100000000 ||
-                !valid(static_cast<double>(n)))
-              throw UsageError(what + " must be " + range + ", got '" + text + "'");
-            o.*field = static_cast<int>(n);
-          },
-          [=](const rs::Options& o) { return json(o.*field); }};
-}
-
-AdvancedOption bool_option(const char* name, bool rs::Options::*field) {
-  return {name, "0, 1, true or false",
-          [=](rs::Options& o, const std::string& text) {
-            if (text == "1" || text == "true") o.*field = true;
-            else if (text == "0" || text == "false") o.*field = false;
-            else throw UsageError(std::string("--option ") + name + " must be 0, 1, true or false, got '" + text + "'");
-          },
-          [=](const rs::Options& o) { return json(o.*field); }};
-}
-
-AdvancedOption neighbourhood_option(const char* name, rs::Neighbourhood rs::Options::*field) {
-  return {name, "geodesic or euclidean",
-          [=](rs::Options& o, const std::string& text) {
-            if (text == "geodesic") o.*field = rs::Neighbourhood::Geodesic;
-            else if (text == "euclidean") o.*field = rs::Neighbourhood::Euclidean;
-            else throw UsageError(std::string("--option ") + name + " must be geodesic or euclidean, got '" + text + "'");
-          },
-          [=](const rs::Options& o) { return json(o.*field == rs::Neighbourhood::Geodesic ? "geodesic" : "euclidean"); }};
-}
-
-const std::vector<AdvancedOption>& advanced_options() {
-  static const std::vector<AdvancedOption> table = {
-      number_option("tau", &rs::Options::tau, "in (0, 1)", [](double x) { return x > 0 && x < 1; }),
-      number_option("epsilon", &rs::Options::epsilon, "in [0, 1)", [](double x) { return x >= 0 && x < 1; }),
-      integer_option("q_samples", &rs::Options::q_samples, "a whole number >= 1", [](double x) { return x >= 1; }),
-      number_option("max_turn_degrees", &rs::Options::max_turn_degrees, "in (0, 180]",
-                    [](double x) { return x > 0 && x <= 180; }),
-      integer_option("lock_interval", &rs::Options::lock_interval, "a whole number >= 1",
-                     [](double x) { return x >= 1; }),
-      number_option("feature_contrast", &rs::Options::feature_contrast, "> 0", [](double x) { return x > 0; }),
-      bool_option("scale_feature_with_spacing", &rs::Options::scale_feature_with_spacing),
-      bool_option("convex_barrier", &rs::Options::convex_barrier),
-      bool_option("remove_loops", &rs::Options::remove_loops),
-      neighbourhood_option("neighbourhood", &rs::Options::neighbourhood),
-      bool_option("planarity_one_ring", &rs::Options::planarity_one_ring),
-      integer_option("threads", &rs::Options::threads, "a whole number >= 0 (0: all cores)",
-                     [](double x) { return x >= 0 && x <= 4096; }),
-  };
-  return table;
-}
-
-std::string advanced_option_names() {
-  std::string names;
-  for (const AdvancedOption& a : advanced_options()) names += (names.empty() ? "" : ", ") + std::string(a.name);
-  return names;
-}
+// The engine's option table (relief_snake/option_table.hpp) parses and range-checks
+// each value; here a bad one is a usage error (exit 2).
 
 std::string advanced_options_help() {
-  std::string text = "advanced options of segment (--option NAME=VALUE, repeatable; docs/design.md says which depart from the paper):\n";
+  std::string text =
+      "advanced options of segment (--option NAME=VALUE, repeatable; docs/design.md says which depart from the paper):\n";
   const rs::Options defaults;
-  for (const AdvancedOption& a : advanced_options()) {
-    std::string line = std::string("  ") + a.name;
-    line.resize(std::max<std::size_t>(line.size() + 1, 30), ' ');
-    text += line + a.range + " (default " + a.get(defaults).dump() + ")\n";
+  for (const rs::OptionInfo& a : rs::advanced_options()) {
+    std::string line = std::string("  ") + a.name + " ";
+    line.resize(std::max<std::size_t>(line.size(), 30), ' ');
+    text += line + a.range + " (default " + rs::advanced_option_json(defaults, a.name) + "): " + a.help + "\n";
   }
   return text;
 }
@@ -165,13 +84,16 @@ void set_advanced_option(rs::Options& options, const std::string& assignment) {
   const std::size_t eq = assignment.find('=');
   const std::string name = assignment.substr(0, eq);
   if (eq == std::string::npos || name.empty())
-    throw UsageError("--option needs NAME=VALUE, got '" + assignment + "'; valid names: " + advanced_option_names());
-  for (const AdvancedOption& a : advanced_options())
-    if (name == a.name) {
-      a.set(options, assignment.substr(eq + 1));
-      return;
-    }
-  throw UsageError("unknown --option '" + name + "'; valid names: " + advanced_option_names());
+    throw UsageError("--option needs NAME=VALUE, got '" + assignment + "'; valid names: " +
+                     rs::advanced_option_names());
+  bool known = false;
+  for (const rs::OptionInfo& a : rs::advanced_options()) known = known || name == a.name;
+  if (!known) throw UsageError("unknown --option '" + name + "'; valid names: " + rs::advanced_option_names());
+  try {
+    rs::set_advanced_option(&options, name, assignment.substr(eq + 1));
+  } catch (const rs::Error& e) {
+    throw UsageError(std::string("--") + e.what());
+  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -415,7 +337,8 @@ int run_segment(const std::vector<std::string>& args) {
                      {"relief_side", o.relief_side == rs::ReliefSide::Left ? "left" : "right"},
                      {"picks", a.picks},
                      {"max_iterations", o.max_iterations}};
-  for (const AdvancedOption& option : advanced_options()) parameters[option.name] = option.get(o);
+  for (const rs::OptionInfo& option : rs::advanced_options())
+    parameters[option.name] = json::parse(rs::advanced_option_json(o, option.name));
   for (const auto& [name, value] : d.named_values()) parameters[name] = value;
   const json out = {{"status", rs::to_string(result.status)},
                     {"closed", result.closed},

@@ -22,6 +22,7 @@
 
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
+#include "relief_snake/option_table.hpp"
 #include "relief_snake/segment.hpp"
 
 #ifndef RELIEF_SNAKE_VERSION
@@ -232,8 +233,43 @@ std::unique_ptr<Mesh> build_mesh(py::handle vertices, py::handle triangles) {
 
 // --- segmentation ---------------------------------------------------------------
 
+/// The text form of an advanced option's value, checked against its type (a Python bool for
+/// booleans, an int for whole numbers, a str for choices); the option table checks the range.
+std::string option_text(const OptionInfo& info, py::handle value) {
+  const bool is_bool = PyBool_Check(value.ptr());
+  const bool is_int = !is_bool && PyLong_Check(value.ptr());
+  const bool is_float = PyFloat_Check(value.ptr());
+  auto wrong = [&](const char* wanted) {
+    const bool ranged = info.type == OptionType::Number || info.type == OptionType::Integer;
+    return Error(std::string("option ") + info.name + " must be " + wanted +
+                 (ranged ? std::string(" ") + info.range : std::string()) + ", got " +
+                 std::string(py::str(py::repr(value))));
+  };
+  switch (info.type) {
+    case OptionType::Boolean:
+      if (!is_bool) throw wrong("True or False");
+      return value.ptr() == Py_True ? "true" : "false";
+    case OptionType::Integer:
+      if (!is_int) throw wrong("an int");
+      return std::string(py::str(value));
+    case OptionType::Number:
+      if (!is_int && !is_float) throw wrong("a number");
+      return std::string(py::str(py::repr(py::float_(py::reinterpret_borrow<py::object>(value)))));
+    case OptionType::Choice:
+      if (!PyUnicode_Check(value.ptr())) throw wrong("a str");
+      return value.cast<std::string>();
+  }
+  throw wrong("a value");
+}
+
+/// An advanced option's value as a Python object: float, int, bool or str by its type.
+py::object option_value(const Options& options, const OptionInfo& info) {
+  py::object value = py::module_::import("json").attr("loads")(advanced_option_json(options, info.name));
+  return info.type == OptionType::Number ? py::float_(value) : value;
+}
+
 Options make_options(double step_height, double w_int, bool open_contour, const std::string& relief_side,
-                     int max_iterations) {
+                     int max_iterations, const py::kwargs& advanced) {
   if (!std::isfinite(step_height) || step_height <= 0)
     throw Error("step_height must be a finite number > 0 (measure the relief's step, e.g. with measure())");
   if (!std::isfinite(w_int) || w_int <= 0 || w_int > 1) throw Error("w_int must be in (0, 1]; the paper uses 0.25");
@@ -246,6 +282,16 @@ Options make_options(double step_height, double w_int, bool open_contour, const 
   options.closed = !open_contour;
   options.relief_side = relief_side == "left" ? ReliefSide::Left : ReliefSide::Right;
   options.max_iterations = max_iterations;
+  for (const auto& [key, value] : advanced) {
+    const std::string name = py::str(key);
+    const OptionInfo* info = nullptr;
+    for (const OptionInfo& o : advanced_options())
+      if (name == o.name) info = &o;
+    if (!info)
+      throw py::type_error("segment() got an unexpected keyword argument '" + name +
+                           "'; the advanced options are: " + advanced_option_names());
+    set_advanced_option(&options, name, option_text(*info, value));
+  }
   return options;
 }
 
@@ -276,6 +322,8 @@ py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, double
   parameters["open"] = !o.closed;
   parameters["relief_side"] = o.relief_side == ReliefSide::Left ? "left" : "right";
   parameters["max_iterations"] = o.max_iterations;
+  parameters["w_int"] = o.w_int;
+  for (const OptionInfo& option : advanced_options()) parameters[option.name] = option_value(o, option);
 
   py::dict out;
   out["status"] = to_string(r.status);
@@ -296,10 +344,8 @@ py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, double
 /// Runs one segmentation with the GIL released. The Python callback (if any) is
 /// called with the GIL re-acquired; its exception cancels the run and is re-raised here.
 py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lock, py::handle picks_obj,
-                          double step_height, double w_int, bool open_contour, const std::string& relief_side,
-                          int max_iterations, py::object progress, double seconds_before) {
+                          const Options& options, py::object progress, double seconds_before) {
   const auto start = std::chrono::steady_clock::now();
-  const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations);
   const std::vector<std::int64_t> picks = read_picks(picks_obj);
   const auto n_input = static_cast<std::int64_t>(mesh.input_vertex_count());
   for (std::int64_t p : picks)
@@ -357,9 +403,9 @@ class PyMesh {
   }
 
   py::dict segment(py::object picks, double step_height, double w_int, bool open_contour,
-                   const std::string& relief_side, int max_iterations, py::object progress) {
-    return run_segmentation(*segmenter_, *mesh_, &lock_, picks, step_height, w_int, open_contour, relief_side,
-                            max_iterations, std::move(progress), 0.0);
+                   const std::string& relief_side, int max_iterations, py::object progress, const py::kwargs& advanced) {
+    const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
+    return run_segmentation(*segmenter_, *mesh_, &lock_, picks, options, std::move(progress), 0.0);
   }
 
   double measure(std::int64_t i, std::int64_t j) const { return measure_distance(*mesh_, i, j); }
@@ -400,19 +446,22 @@ PYBIND11_MODULE(relief_snake_core, m) {
 
   const char* segment_doc =
       "segment(vertices, triangles, picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left',\n"
-      "        max_iterations=3000, progress=None) -> dict\n\n"
+      "        max_iterations=3000, progress=None, **advanced) -> dict\n\n"
       "vertices: n by 3 (or flat 3n) floats; triangles: m by 3 (or flat 3m) integer vertex indices;\n"
       "picks: vertex indices around the relief, in order (>= 3 closed, >= 2 open); step_height: h > 0.\n"
       "progress(phase: str, iteration: int, snaxels: int, contour: list of (x, y, z)) -> bool|None is called\n"
       "every iteration; returning False raises Cancelled. Returns a dict with status, closed, contour,\n"
-      "relief_vertices, phases, parameters, planarity_vertices, notes, mesh_report and seconds.";
+      "relief_vertices, phases, parameters, planarity_vertices, notes, mesh_report and seconds.\n"
+      "**advanced: the engine's advanced options by name (e.g. tau=0.2, exact_q=True); advanced_options()\n"
+      "lists them with their types, ranges and defaults. An unknown name raises TypeError.";
 
   m.def(
       "segment",
       [](py::object vertices, py::object triangles, py::object picks, double step_height, double w_int,
-         bool open_contour, const std::string& relief_side, int max_iterations, py::object progress) {
+         bool open_contour, const std::string& relief_side, int max_iterations, py::object progress,
+         const py::kwargs& advanced) {
         // Options are checked before the (possibly long) mesh construction.
-        make_options(step_height, w_int, open_contour, relief_side, max_iterations);
+        const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
         const auto start = std::chrono::steady_clock::now();
         std::unique_ptr<Mesh> mesh = build_mesh(vertices, triangles);
         std::unique_ptr<Segmenter> segmenter;
@@ -422,12 +471,33 @@ PYBIND11_MODULE(relief_snake_core, m) {
         }
         std::mutex lock;
         const double before = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return run_segmentation(*segmenter, *mesh, &lock, picks, step_height, w_int, open_contour, relief_side,
-                                max_iterations, std::move(progress), before);
+        return run_segmentation(*segmenter, *mesh, &lock, picks, options, std::move(progress), before);
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("picks"), py::arg("step_height"), py::kw_only(),
       py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
       py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), segment_doc);
+
+  m.def(
+      "advanced_options",
+      [] {
+        const Options defaults;
+        py::list out;
+        for (const OptionInfo& o : advanced_options()) {
+          py::dict d;
+          d["name"] = o.name;
+          d["type"] = o.type == OptionType::Number    ? "number"
+                      : o.type == OptionType::Integer ? "integer"
+                      : o.type == OptionType::Boolean ? "boolean"
+                                                      : "choice";
+          d["range"] = o.range;
+          d["help"] = o.help;
+          d["default"] = option_value(defaults, o);
+          out.append(d);
+        }
+        return out;
+      },
+      "advanced_options() -> list of dict(name, type, range, help, default): the keyword arguments segment()\n"
+      "accepts beyond the main ones; most are fixed by the paper and exposed for experiments.");
 
   m.def("measure", [](py::object vertices, std::int64_t i, std::int64_t j) { return measure_vertices(vertices, i, j); },
         py::arg("vertices"), py::arg("i"), py::arg("j"),
@@ -452,7 +522,7 @@ PYBIND11_MODULE(relief_snake_core, m) {
            py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
            py::arg("max_iterations") = 3000, py::arg("progress") = py::none(),
            "segment(picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left', "
-           "max_iterations=3000, progress=None) -> dict (see relief_snake_core.segment)")
+           "max_iterations=3000, progress=None, **advanced) -> dict (see relief_snake_core.segment)")
       .def("measure", &PyMesh::measure, py::arg("i"), py::arg("j"),
            "measure(i, j) -> float: Euclidean distance between input vertices i and j.")
       .def("__repr__", [](const PyMesh& self) {

@@ -35,13 +35,20 @@ double normalise_beta(double l, double max_turn_degrees) {
   return shortest * shortest / worst;
 }
 
-FeatureEnergy::FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples)
-    : planarity_(planarity) {
+FeatureEnergy::FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples, bool exact_q)
+    : planarity_(planarity), exact_q_(exact_q), q_from_((1 - epsilon) * h), q_to_((1 + epsilon) * h) {
   const int n = std::max(1, q_samples);
   for (int k = 0; k < n; ++k) {
     const double t = n == 1 ? 0.0 : -1.0 + 2.0 * k / (n - 1);
     distances_.push_back((1 + t * epsilon) * h);
   }
+}
+
+void FeatureEnergy::q_candidates(const SurfacePoint& x, const Vec3& inward, std::vector<SurfacePoint>* out) const {
+  if (exact_q_)
+    walk_stretch(planarity_.mesh(), x, inward, q_from_, q_to_, out);
+  else
+    walk_sampled(planarity_.mesh(), x, inward, distances_, out);
 }
 
 double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
@@ -64,7 +71,7 @@ void FeatureEnergy::prefetch(const std::vector<SurfacePoint>& points, const std:
   };
   for (std::size_t i = 0; i < points.size(); ++i) {
     corners(points[i]);
-    walk_sampled(mesh, points[i], inward[i], distances_, &samples_[0]);
+    q_candidates(points[i], inward[i], &samples_[0]);
     for (const SurfacePoint& q : samples_[0]) corners(q);
   }
   planarity_.prefetch_filtered(vertices_);
@@ -80,7 +87,7 @@ void FeatureEnergy::unscaled(const SurfacePoint* xs, int count, const Vec3& inwa
     for (int k = 0; k < 3; ++k) vertices_.push_back(mesh.face_vertex(p.face, k));
   };
   for (int i = 0; i < count; ++i) {
-    walk_sampled(mesh, xs[i], inward, distances_, &samples_[i]);
+    q_candidates(xs[i], inward, &samples_[i]);
     corners(xs[i]);
     for (const SurfacePoint& q : samples_[i]) corners(q);
   }

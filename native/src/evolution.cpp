@@ -99,7 +99,7 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
                        const ProgressCallback& progress) {
   PhaseOutcome outcome;
   const double lock_distance = 2 * phase.tau * phase.l;
-  std::vector<Vec3> polyline;
+  std::vector<Vec3> polyline, checkpoint;
   for (int iteration = 1; iteration <= phase.max_iterations; ++iteration) {
     outcome.iterations = iteration;
     int changes = greedy_iteration(snake, feature, phase);
@@ -136,6 +136,19 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
     if (changes == 0) {
       outcome.converged = true;
       return outcome;
+    }
+    // The lock's rule applied to the snake's shape, so that resampling (which makes
+    // new, unlocked snaxels) cannot keep a phase alive: every lock_interval
+    // iterations, if no snaxel is farther than 2 tau l from the snake as it was
+    // lock_interval iterations ago, what still moves is a slow circulation along
+    // the contour (a few snaxels trading places with splits and merges), not
+    // progress, and the phase has converged.
+    if (iteration % phase.lock_interval == 0) {
+      if (!checkpoint.empty() && snake.within(checkpoint, lock_distance)) {
+        outcome.converged = true;
+        return outcome;
+      }
+      checkpoint = snake.polyline();
     }
   }
   return outcome;

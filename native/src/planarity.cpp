@@ -8,9 +8,9 @@
 #include <limits>
 #include <string>
 
-#include <Eigen/Eigenvalues>
 
 #include "relief_snake/error.hpp"
+#include "relief_snake/plane_fit.hpp"
 #include "worker_pool.hpp"
 
 namespace relief_snake {
@@ -19,6 +19,12 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Neighbourhood::Sphere leaves out surface whose normal turns more than 120 degrees
+// from v's: the far side of a thin shell, not the walls of a step.
+constexpr double kSphereMinFacing = -0.5;
+// ... and counts parts of the tree smaller than h / 4 whole or not at all, by their
+// centroid, as it does faces: the cost per vertex stops growing with the resolution.
+constexpr double kSphereGrain = 0.25;
 
 // Kimmel-Sethian first-order update of the distance at C from the known
 // distances dA, dB at A and B of the triangle (A, B, C): the planar wavefront
@@ -77,14 +83,24 @@ double point_source_update(const Vec3& A, const Vec3& B, const Vec3& C, double d
 
 }  // namespace
 
-PlanarityField::PlanarityField(const Mesh& mesh, const PlanarityOptions& options)
-    : mesh_(mesh), options_(options) {
+MomentTree::Elements PlanarityField::tree_elements(PlaneFit fit) {
+  return fit == PlaneFit::Area ? MomentTree::Elements::Faces : MomentTree::Elements::Vertices;
+}
+
+PlanarityField::PlanarityField(const Mesh& mesh, const PlanarityOptions& options,
+                               std::shared_ptr<const MomentTree> tree)
+    : mesh_(mesh), options_(options), tree_(std::move(tree)) {
   if (!std::isfinite(options.radius) || options.radius <= 0)
     throw Error("planarity radius (the step height h) must be a positive finite number, got " +
                 std::to_string(options.radius));
   if (std::isnan(options.sigma_s) || std::isinf(options.sigma_s))
     throw Error("planarity sigma_s must be finite (or <= 0 to estimate it from the data)");
   if (options.sigma_s > 0) sigma_s_ = options.sigma_s;
+  if (options.neighbourhood == Neighbourhood::Sphere) {
+    const MomentTree::Elements wanted = tree_elements(options.fit);
+    if (!tree_ || &tree_->mesh() != &mesh || tree_->elements() != wanted)
+      tree_ = std::make_shared<const MomentTree>(mesh, wanted);
+  }
   const std::size_t n = static_cast<std::size_t>(mesh.n_vertices());
   raw_.assign(n, kNaN);
   filtered_.assign(n, kNaN);
@@ -257,50 +273,77 @@ void PlanarityField::euclidean_ball(int v, Scratch& s) const {
 }
 
 double PlanarityField::compute_raw(int v, Scratch& s) const {
+  const Vec3& pv = mesh_.position(v);
+  const Vec3& vn = mesh_.vertex_normal(v);
+  if (options_.neighbourhood == Neighbourhood::Sphere) {
+    MomentTree::Query q;
+    q.center = pv;
+    q.radius = options_.radius;
+    q.component = mesh_.component(v);
+    q.facing = vn;
+    q.min_facing = kSphereMinFacing;
+    q.grain = kSphereGrain * options_.radius;
+    PlaneMoments m = tree_->sphere(q);
+    const double r2 = options_.radius * options_.radius;
+    if (options_.fit == PlaneFit::Vertices) {
+      m.weight -= 1;  // v itself is in the sphere; about v its first and second moments are zero
+      if (options_.include_one_ring)
+        for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
+          if ((mesh_.position(*it) - pv).squaredNorm() > r2) m.add_point(mesh_.position(*it) - pv);
+      if (m.weight < 2.5) return one_ring_planarity(v);  // h smaller than the edges
+    } else if (options_.include_one_ring) {
+      // v's own faces count whole, like the one-ring of a vertex fit.
+      for (const int* f = mesh_.faces_begin(v); f != mesh_.faces_end(v); ++f) {
+        const Vec3 a = mesh_.position(mesh_.face_vertex(*f, 0)) - pv, b = mesh_.position(mesh_.face_vertex(*f, 1)) - pv,
+                   c = mesh_.position(mesh_.face_vertex(*f, 2)) - pv;
+        if (((a + b + c) / 3.0).squaredNorm() > r2) m.add_triangle(a, b, c);
+      }
+    }
+    return planarity_about_vertex(m, vn);
+  }
+
   if (options_.neighbourhood == Neighbourhood::Euclidean)
     euclidean_ball(v, s);
   else
     march(v, s);
   if (options_.include_one_ring) {
-    for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
-      if (!s.accepted[*it]) s.ball.push_back(*it);  // beyond h, but adjacent
+    for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it) {
+      const int w = *it;
+      if (s.accepted[w]) continue;
+      s.ball.push_back(w);  // beyond h, but adjacent
+      s.accepted[w] = 1;    // marked for the area fit below; reset() clears it
+      s.touched.push_back(w);
+    }
+  }
+  PlaneMoments m;
+  if (options_.fit == PlaneFit::Area) {
+    // The faces with every corner in the neighbourhood (ball[0] is v), each once:
+    // from its lowest-numbered corner.
+    const int* corners = mesh_.face_vertices();
+    for (int u : s.ball)
+      for (const int* f = mesh_.faces_begin(u); f != mesh_.faces_end(u); ++f) {
+        const int* c = corners + 3 * *f;
+        if (!s.accepted[c[0]] || !s.accepted[c[1]] || !s.accepted[c[2]] || u != std::min({c[0], c[1], c[2]}))
+          continue;
+        m.add_triangle(mesh_.position(c[0]) - pv, mesh_.position(c[1]) - pv, mesh_.position(c[2]) - pv);
+      }
+    reset(s);
+    return planarity_about_vertex(m, vn);
   }
   reset(s);
   // ball[0] is v itself; the neighbours are the rest.
-  const int* begin = s.ball.data() + 1;
-  const int* end = s.ball.data() + s.ball.size();
-  if (end - begin < 3) {  // h smaller than the edges: fall back to the one-ring
-    begin = mesh_.neighbors_begin(v);
-    end = mesh_.neighbors_end(v);
-  }
-  const std::ptrdiff_t n = end - begin;
-  if (n < 3) return 0.0;  // a plane through v and <= 2 neighbours contains v
+  if (s.ball.size() < 4) return one_ring_planarity(v);  // h smaller than the edges
+  for (std::size_t k = 1; k < s.ball.size(); ++k) m.add_point(mesh_.position(s.ball[k]) - pv);
+  return planarity_about_vertex(m, vn);
+}
 
-  // Work relative to v: P = (c - v) . n needs no absolute coordinates.
+double PlanarityField::one_ring_planarity(int v) const {
   const Vec3& pv = mesh_.position(v);
-  Vec3 centroid = Vec3::Zero();
-  for (const int* it = begin; it != end; ++it) centroid += mesh_.position(*it) - pv;
-  centroid /= static_cast<double>(n);
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const int* it = begin; it != end; ++it) {
-    const Vec3 q = mesh_.position(*it) - pv - centroid;
-    cov.noalias() += q * q.transpose();
-  }
-  cov /= static_cast<double>(n);
-
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(cov);
-  const Vec3 evals = solver.eigenvalues();  // increasing
-  const Vec3& vn = mesh_.vertex_normal(v);
-  Vec3 normal;
-  if (!(evals(2) > 0)) return 0.0;  // all neighbours coincide
-  if (evals(1) <= 1e-12 * evals(2)) {
-    normal = vn;  // collinear neighbours: the plane's normal is undetermined, use the surface's
-  } else {
-    normal = solver.eigenvectors().col(0);
-    if (normal.dot(vn) < 0) normal = -normal;
-  }
-  return centroid.dot(normal);
+  PlaneMoments m;
+  for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
+    m.add_point(mesh_.position(*it) - pv);
+  if (m.weight < 3) return 0.0;  // a plane through v and <= 2 neighbours contains v
+  return planarity_about_vertex(m, mesh_.vertex_normal(v));
 }
 
 void PlanarityField::two_ring(int v, Scratch& s, std::vector<int>* out) const {

@@ -112,6 +112,7 @@ std::vector<int> planarity_sample(const Mesh& mesh, const std::vector<SurfacePoi
 struct Segmenter::Cache {
   std::unique_ptr<PlanarityField> planarity;
   PlanarityOptions options;  // what it was computed with
+  std::shared_ptr<const MomentTree> tree;  // does not depend on h: kept across planarity fields
 };
 
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
@@ -155,11 +156,15 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   po.radius = h;
   po.threads = options.threads;
   po.neighbourhood = options.neighbourhood;
+  po.fit = options.plane_fit;
   po.include_one_ring = options.planarity_one_ring;
   const PlanarityOptions& was = cache_->options;
-  if (!cache_->planarity || was.radius != h || was.neighbourhood != po.neighbourhood ||
+  if (!cache_->planarity || was.radius != h || was.neighbourhood != po.neighbourhood || was.fit != po.fit ||
       was.include_one_ring != po.include_one_ring) {
-    cache_->planarity = std::make_unique<PlanarityField>(mesh, po);
+    std::shared_ptr<const MomentTree> tree;
+    if (cache_->tree && cache_->tree->elements() == PlanarityField::tree_elements(po.fit)) tree = cache_->tree;
+    cache_->planarity = std::make_unique<PlanarityField>(mesh, po, tree);
+    if (cache_->planarity->tree()) cache_->tree = cache_->planarity->tree();
     cache_->planarity->estimate_sigma_s(planarity_sample(mesh, start, mesh.component(pick_vertices.front())));
     cache_->options = po;
   }
@@ -198,7 +203,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   param.w_d = 4 - 2 * options.w_int - param.w_f;
 
   Snake snake(mesh, start, options.closed, inside_left);
-  FeatureEnergy feature(planarity, h, options.epsilon, options.q_samples);
+  snake.set_nearest_resampling(options.nearest_resampling);
+  FeatureEnergy feature(planarity, h, options.epsilon, options.q_samples, options.exact_q);
   feature.set_convex_barrier(options.convex_barrier);
 
   PhaseSettings base;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include <Eigen/Geometry>
 
@@ -25,7 +26,7 @@ int boundary_edge_at(const Mesh& mesh, int g, int v, bool leaving) {
 }  // namespace
 
 std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b,
-                                          const std::vector<double>& fractions) {
+                                          const std::vector<double>& fractions, bool nearest) {
   const Vec3 pa = position(mesh, a), pb = position(mesh, b);
   const double d = (pb - pa).norm();
   std::vector<double> distances;
@@ -36,11 +37,22 @@ std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& 
   walk_sampled(mesh, a, pb - pa, distances, &out);
   // A boundary can cut the walk short: fill the rest with the last point reached.
   while (out.size() < fractions.size()) out.push_back(out.empty() ? a : out.back());
+  if (nearest) {
+    // The walk's end can drift off the chord where the surface folds (a steep,
+    // sparsely sampled step wall): take the surface point nearest the chord point,
+    // searched from where the walk got to.
+    std::vector<int> scratch;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Vec3 target = pa + fractions[k] * (pb - pa);
+      const double r = (position(mesh, out[k]) - target).norm();
+      out[k] = closest_point_near(mesh, out[k], target, r * (1 + 1e-9) + 1e-12 * d, &scratch);
+    }
+  }
   return out;
 }
 
-SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b) {
-  return surface_between(mesh, a, b, {0.5}).front();
+SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b, bool nearest) {
+  return surface_between(mesh, a, b, {0.5}, nearest).front();
 }
 
 bool boundary_edge_of(const Mesh& mesh, const SurfacePoint& p, int* face, int* edge) {
@@ -217,7 +229,7 @@ int Snake::append_between(int i, int j, int pieces, std::vector<Snaxel>* out) co
   if (pieces < 2) return 0;
   std::vector<double> fractions;
   for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
-  for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions))
+  for (const SurfacePoint& p : surface_between(mesh_, snaxels_[i].point, snaxels_[j].point, fractions, nearest_resampling_))
     out->push_back(make(p));  // new snaxels start as moved
   return pieces - 1;
 }
@@ -251,7 +263,7 @@ int Snake::resample(double l) {
     } else if (is_end(j)) {
       snaxels_.erase(snaxels_.begin() + i);
     } else {
-      Snaxel merged = make(surface_midpoint(mesh_, snaxels_[i].point, snaxels_[j].point));
+      Snaxel merged = make(surface_midpoint(mesh_, snaxels_[i].point, snaxels_[j].point, nearest_resampling_));
       merged.moved = true;
       snaxels_[i] = merged;
       snaxels_.erase(snaxels_.begin() + j);
@@ -387,6 +399,52 @@ void Snake::reset_state() {
     s.anchor = s.position;
     s.age = 0;
   }
+}
+
+bool Snake::within(const std::vector<Vec3>& old, double tolerance) const {
+  const int m = static_cast<int>(old.size());
+  if (m == 0) return snaxels_.empty();
+  const int segments = closed_ ? m : m - 1;
+  if (segments <= 0) {
+    for (const Snaxel& s : snaxels_)
+      if ((s.position - old[0]).norm() > tolerance) return false;
+    return true;
+  }
+  // A hash grid of the old segments, each entered in every cell its box (grown by
+  // the tolerance) touches; a point then only looks at its own cell.
+  double longest = 0;
+  for (int k = 0; k < segments; ++k) longest = std::max(longest, (old[(k + 1) % m] - old[k]).norm());
+  const double cell = std::max(longest, tolerance) + tolerance;
+  auto key = [cell](long long x, long long y, long long z) { return (x * 73856093LL) ^ (y * 19349663LL) ^ (z * 83492791LL); };
+  std::unordered_map<long long, std::vector<int>> grid;
+  grid.reserve(static_cast<std::size_t>(segments) * 2);
+  for (int k = 0; k < segments; ++k) {
+    const Vec3 &a = old[k], &b = old[(k + 1) % m];
+    const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(tolerance), hi = a.cwiseMax(b) + Vec3::Constant(tolerance);
+    for (long long x = std::floor(lo.x() / cell); x <= std::floor(hi.x() / cell); ++x)
+      for (long long y = std::floor(lo.y() / cell); y <= std::floor(hi.y() / cell); ++y)
+        for (long long z = std::floor(lo.z() / cell); z <= std::floor(hi.z() / cell); ++z) grid[key(x, y, z)].push_back(k);
+  }
+  const double t2 = tolerance * tolerance;
+  for (const Snaxel& s : snaxels_) {
+    const Vec3& p = s.position;
+    const auto it = grid.find(key(std::floor(p.x() / cell), std::floor(p.y() / cell), std::floor(p.z() / cell)));
+    bool near = false;
+    if (it != grid.end()) {
+      for (int k : it->second) {
+        const Vec3 &a = old[k], &b = old[(k + 1) % m];
+        const Vec3 ab = b - a;
+        const double len2 = ab.squaredNorm();
+        const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+        if ((a + t * ab - p).squaredNorm() <= t2) {
+          near = true;
+          break;
+        }
+      }
+    }
+    if (!near) return false;
+  }
+  return true;
 }
 
 std::vector<Vec3> Snake::polyline() const {

@@ -122,8 +122,10 @@ namespace {
 
 // The walk behind walk() and walk_sampled(); distances as a plain array so a
 // single-distance walk (the snake's inner loop) allocates nothing.
+// crossings (optional): every edge crossing at a distance in [crossings_from, total].
 Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
-               std::size_t n_samples, std::vector<SurfacePoint>* samples) {
+               std::size_t n_samples, std::vector<SurfacePoint>* samples,
+               std::vector<SurfacePoint>* crossings = nullptr, double crossings_from = 0) {
   Walk result;
   result.end = start;
   if (samples) samples->clear();
@@ -189,6 +191,7 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
     if (!(s > 0)) break;
     e /= s;
     travelled += t_exit;
+    if (crossings && travelled >= crossings_from && travelled <= total) crossings->push_back(SurfacePoint{f, e});
 
     const int g = mesh.face_neighbor(f, exit_k);
     const int ka = (exit_k + 1) % 3, kb = (exit_k + 2) % 3;
@@ -245,6 +248,86 @@ Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, do
 Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
                   const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
   return walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), samples);
+}
+
+namespace {
+
+// Closest point to p on triangle (a, b, c), as barycentric weights (Ericson,
+// Real-Time Collision Detection, 5.1.5: Voronoi regions of the corners and edges).
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return Vec3(1, 0, 0);
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return Vec3(0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double t = d1 / (d1 - d3);
+    return Vec3(1 - t, t, 0);
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return Vec3(0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double t = d2 / (d2 - d6);
+    return Vec3(1 - t, 0, t);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return Vec3(0, 1 - t, t);
+  }
+  const double denom = va + vb + vc;
+  if (!(std::abs(denom) > 0)) return Vec3(1, 0, 0);  // degenerate triangle: its first corner
+  const double v = vb / denom, w = vc / denom;
+  return Vec3(1 - v - w, v, w);
+}
+
+}  // namespace
+
+SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, const Vec3& target, double radius,
+                                std::vector<int>* scratch) {
+  if (!start.valid()) return start;
+  std::vector<int> local;
+  std::vector<int>& visited = scratch ? *scratch : local;
+  visited.clear();
+  SurfacePoint best = start;
+  double best_d2 = (position(mesh, start) - target).squaredNorm();
+  const double r2 = radius * radius;
+  // Breadth-first over faces sharing a corner, through faces that come within
+  // `radius` of the target; the visited list doubles as the queue (it stays small).
+  visited.push_back(start.face);
+  for (std::size_t k = 0; k < visited.size(); ++k) {
+    const int f = visited[k];
+    const Vec3 &a = mesh.position(mesh.face_vertex(f, 0)), &b = mesh.position(mesh.face_vertex(f, 1)),
+               &c = mesh.position(mesh.face_vertex(f, 2));
+    const Vec3 w = closest_on_triangle(target, a, b, c);
+    const double d2 = (w[0] * a + w[1] * b + w[2] * c - target).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = SurfacePoint{f, w};
+    }
+    if (d2 > r2 && k > 0) continue;  // too far: do not grow the search through it
+    for (int j = 0; j < 3; ++j) {
+      const int v = mesh.face_vertex(f, j);
+      for (const int* g = mesh.faces_begin(v); g != mesh.faces_end(v); ++g)
+        if (std::find(visited.begin(), visited.end(), *g) == visited.end()) visited.push_back(*g);
+    }
+    if (visited.size() > 4096) break;  // a guard for absurd radii; the search is meant to be local
+  }
+  return best;
+}
+
+Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double from, double to,
+                  std::vector<SurfacePoint>* points) {
+  points->clear();
+  std::vector<SurfacePoint> ends;
+  const double distances[2] = {from, to};
+  const Walk w = walk_impl(mesh, start, direction, distances, to > from ? 2 : 1, &ends, points, from);
+  points->insert(points->end(), ends.begin(), ends.end());
+  return w;
 }
 
 }  // namespace relief_snake

@@ -8,6 +8,8 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <memory>
+#include <string>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -402,4 +404,64 @@ TEST(Planarity, TimingOn300kTriangles) {
   RecordProperty("scattered_ms_per_1000", std::to_string(scattered_ms));
   EXPECT_LT(field.raw_count(), static_cast<std::size_t>(mesh.n_vertices()) / 4);
   EXPECT_LE(field.filtered_count(), 2000u);
+}
+
+TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
+  // The same step of height h rising over one cell (x in [0, 0.2], no vertex on the
+  // wall), sampled twice: on a uniform grid, and with the relief top beyond x = 0.2
+  // sampled twice as densely across. The vertex fit at the top edge follows the vertex
+  // counts; the area fit follows the surface and does not move.
+  auto step = [](double x, double y) { return rs::Vec3(x, y, x <= 1e-9 ? 0.0 : kH); };
+  Grid uniform = make_grid(60, 30, kCell, -6.0, -3.0, step);
+  Grid denser = make_grid(60, 30, kCell, -6.0, -3.0, [&](double x, double y) {
+    return step(x <= kCell + 1e-9 ? x : kCell + 0.5 * (x - kCell), y);
+  });
+  const rs::Mesh mu = uniform.mesh(), md = denser.mesh();
+  const int foot = uniform.index(30, 15), top = uniform.index(31, 15), far = uniform.index(15, 15);
+  ASSERT_NEAR(mu.position(top).x(), md.position(top).x(), 1e-12);
+  for (auto n : {rs::Neighbourhood::Geodesic, rs::Neighbourhood::Euclidean, rs::Neighbourhood::Sphere}) {
+    auto field = [&](const rs::Mesh& m, rs::PlaneFit fit) {
+      rs::PlanarityOptions o{kH, 0.0};
+      o.neighbourhood = n;
+      o.fit = fit;
+      return std::make_unique<rs::PlanarityField>(m, o);
+    };
+    auto au = field(mu, rs::PlaneFit::Area), ad = field(md, rs::PlaneFit::Area);
+    auto vu = field(mu, rs::PlaneFit::Vertices), vd = field(md, rs::PlaneFit::Vertices);
+    const std::string what = "neighbourhood " + std::to_string(static_cast<int>(n));
+    EXPECT_GT(au->raw(foot), 0.1) << what;   // the signs of the step
+    EXPECT_LT(au->raw(top), -0.1) << what;
+    EXPECT_NEAR(au->raw(far), 0.0, 1e-9) << what;
+    EXPECT_NEAR(ad->raw(top), au->raw(top), 0.01) << what;
+    EXPECT_GT(std::abs(vd->raw(top) - vu->raw(top)), 0.03) << what;
+  }
+}
+
+TEST(Planarity, SphereNeighbourhoodSkipsTheFarSideOfAThinShell) {
+  // Two sheets 0.3 apart, facing away from each other and joined along one edge (a thin
+  // plate): the sphere of radius 1 around a vertex of the top sheet reaches the bottom
+  // sheet, whose normals point the other way; it must not tilt the top sheet's plane.
+  std::vector<double> V;
+  std::vector<std::int64_t> F;
+  const int n = 21;
+  for (int sheet = 0; sheet < 2; ++sheet)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) V.insert(V.end(), {0.2 * i, 0.2 * j, sheet ? -0.3 : 0.0});
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const std::int64_t a = j * n + i, b = a + 1, c = a + n + 1, d = a + n, o = n * n;
+      F.insert(F.end(), {a, b, c, a, c, d});                  // top: normal +z
+      F.insert(F.end(), {o + a, o + c, o + b, o + a, o + d, o + c});  // bottom: normal -z
+    }
+  for (int j = 0; j + 1 < n; ++j) {  // a wall along x = 0 joins them, oriented like both sheets
+    const std::int64_t a = j * n, d = a + n, o = n * n;
+    F.insert(F.end(), {a, o + d, o + a, a, d, o + d});
+  }
+  const rs::Mesh mesh = rs::Mesh::from_triangles(V.data(), V.size() / 3, F.data(), F.size() / 3);
+  ASSERT_EQ(mesh.report().components, 1u);
+  rs::PlanarityOptions o{1.0, 0.0};
+  o.neighbourhood = rs::Neighbourhood::Sphere;
+  o.fit = rs::PlaneFit::Area;
+  rs::PlanarityField field(mesh, o);
+  EXPECT_NEAR(field.raw(mesh.input_to_mesh(10 * n + 12)), 0.0, 1e-9);  // mid top sheet, 2.4 from the wall
 }

@@ -146,3 +146,38 @@ TEST(Snake, RemoveLoopsLeavesASimpleCurveAlone) {
   EXPECT_EQ(snake.remove_loops(), 0);
   EXPECT_EQ(snake.size(), 40);
 }
+
+TEST(Snake, WithinToleratesMotionAlongTheContourOnly) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 60), true, true);
+  const std::vector<Vec3> before = snake.polyline();
+  EXPECT_TRUE(snake.within(before, 1e-9));
+  // The same circle sampled elsewhere along it (a circulation): still within.
+  Snake rotated(mesh, circle(mesh, Vec3(10, 10, 0), 5, 47), true, true);
+  EXPECT_TRUE(rotated.within(before, 0.05));   // chords of the 60-gon sag 0.007 at most
+  // A circle 0.2 smaller: not within 0.1.
+  Snake smaller(mesh, circle(mesh, Vec3(10, 10, 0), 4.8, 60), true, true);
+  EXPECT_FALSE(smaller.within(before, 0.1));
+  EXPECT_TRUE(smaller.within(before, 0.25));
+}
+
+TEST(Snake, NearestResamplingKeepsNewSnaxelsOffAOneTriangleWall) {
+  // A relief x > 4.5 + 0.3 |y - 7| of height 1 whose wall is a single band of grid
+  // triangles (no vertex on it), pointing its corner at y = 7. The chord between two
+  // points at its foot (y = 6 and y = 8, x = 4.75) passes under the corner: a straight
+  // surface walk along it climbs the wall, the surface point nearest the chord stays
+  // at the foot (about 0.06 up the wall).
+  const Mesh mesh = test::grid_mesh(81, 81, 20, 20, [](double u, double v) {
+    return Vec3(u, v, u > 4.5 + 0.3 * std::abs(v - 7) + 1e-9 ? 1.0 : 0.0);
+  });
+  const SurfacePoint a = point_at(mesh, Vec3(4.75, 6, 0)), b = point_at(mesh, Vec3(4.75, 8, 0));
+  ASSERT_NEAR(position(mesh, a).z(), 0, 1e-12);
+  ASSERT_NEAR(position(mesh, b).z(), 0, 1e-12);
+  std::vector<double> fractions;
+  for (int k = 1; k < 20; ++k) fractions.push_back(k / 20.0);
+  double walk_top = 0;
+  for (const SurfacePoint& p : surface_between(mesh, a, b, fractions, false))
+    walk_top = std::max(walk_top, position(mesh, p).z());
+  EXPECT_GT(walk_top, 0.3);  // the failure the nearest point avoids
+  for (const SurfacePoint& p : surface_between(mesh, a, b, fractions, true)) EXPECT_LT(position(mesh, p).z(), 0.1);
+}

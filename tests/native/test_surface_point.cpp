@@ -108,3 +108,62 @@ TEST(SurfacePoint, InterpolateIsLinear) {
   const double value = interpolate(mesh, p, [&](int v) { return 2 * mesh.position(v).x() - mesh.position(v).y(); });
   EXPECT_NEAR(value, 2 * x.x() - x.y(), 1e-12);
 }
+
+TEST(SurfacePoint, ClosestPointNearMatchesBruteForce) {
+  // A bumpy sheet; targets a little off the surface; the local search must find the
+  // same nearest point as a scan over every face.
+  const Mesh mesh = test::grid_mesh(31, 31, 6, 6, [](double u, double v) {
+    return Vec3(u, v, 0.4 * std::sin(1.7 * u) * std::cos(1.3 * v));
+  });
+  for (const Vec3& target : {Vec3(2.1, 3.3, 0.5), Vec3(4.0, 1.2, -0.3), Vec3(0.5, 5.5, 0.05), Vec3(3, 3, 0.8)}) {
+    double best = 1e300;
+    for (int f = 0; f < mesh.n_faces(); ++f) {
+      // Dense barycentric sampling is enough for a reference to 1e-3.
+      for (int i = 0; i <= 40; ++i)
+        for (int j = 0; i + j <= 40; ++j) {
+          const SurfacePoint p{f, Vec3(1 - (i + j) / 40.0, i / 40.0, j / 40.0)};
+          best = std::min(best, (position(mesh, p) - target).norm());
+        }
+    }
+    const SurfacePoint start = point_near(mesh, Vec3(target.x(), target.y(), 0));
+    const double r = (position(mesh, start) - target).norm();
+    const SurfacePoint found = closest_point_near(mesh, start, target, r);
+    ASSERT_TRUE(found.valid());
+    EXPECT_NEAR(found.bary.sum(), 1.0, 1e-12);
+    EXPECT_GE(found.bary.minCoeff(), -1e-12);
+    EXPECT_NEAR((position(mesh, found) - target).norm(), best, 2e-3) << target.transpose();
+    EXPECT_LE((position(mesh, found) - target).norm(), best + 1e-12 + 2e-3);
+  }
+}
+
+TEST(SurfacePoint, WalkStretchHoldsTheExtremesOfALinearField) {
+  // A per-vertex field linear inside each face takes its extremes over a stretch of a
+  // walk at the stretch's edge crossings or ends: walk_stretch() must return them all.
+  const Mesh mesh = test::grid_mesh(21, 21, 10, 10, [](double u, double v) { return Vec3(u, v, 0); });
+  auto field = [&](int v) { const Vec3& p = mesh.position(v); return std::sin(3 * p.x()) + std::cos(2.3 * p.y()); };
+  const SurfacePoint start = point_near(mesh, Vec3(2, 3, 0));
+  const Vec3 dir = Vec3(1, 0.37, 0).normalized();
+  std::vector<SurfacePoint> points;
+  const Walk w = walk_stretch(mesh, start, dir, 1.5, 4.0, &points);
+  EXPECT_FALSE(w.hit_boundary);
+  ASSERT_GE(points.size(), 6u);  // the stretch crosses several edges
+  double lo = 1e300, hi = -1e300;
+  for (const SurfacePoint& p : points) {
+    const double d = (position(mesh, p) - position(mesh, start)).norm();
+    EXPECT_GE(d, 1.5 - 1e-9);
+    EXPECT_LE(d, 4.0 + 1e-9);
+    const double f = interpolate(mesh, p, field);
+    lo = std::min(lo, f);
+    hi = std::max(hi, f);
+  }
+  std::vector<double> dense;
+  for (int k = 0; k <= 2000; ++k) dense.push_back(1.5 + 2.5 * k / 2000.0);
+  std::vector<SurfacePoint> samples;
+  walk_sampled(mesh, start, dir, dense, &samples);
+  ASSERT_EQ(samples.size(), dense.size());
+  for (const SurfacePoint& p : samples) {
+    const double f = interpolate(mesh, p, field);
+    EXPECT_GE(f, lo - 1e-9);
+    EXPECT_LE(f, hi + 1e-9);
+  }
+}

@@ -162,9 +162,9 @@ def test_segment_synthetic_scan(cli, build_dir, tmp_path):
     assert recall >= 0.8, (precision, recall)
 
 
-ADVANCED_OPTIONS = ["tau", "epsilon", "q_samples", "max_turn_degrees", "lock_interval", "feature_contrast",
-                    "scale_feature_with_spacing", "convex_barrier", "remove_loops", "neighbourhood",
-                    "planarity_one_ring", "threads"]
+ADVANCED_OPTIONS = ["tau", "epsilon", "q_samples", "exact_q", "max_turn_degrees", "lock_interval",
+                    "feature_contrast", "scale_feature_with_spacing", "convex_barrier", "remove_loops",
+                    "nearest_resampling", "neighbourhood", "plane_fit", "planarity_one_ring", "threads"]
 
 
 def test_help_lists_the_advanced_options(cli):
@@ -191,7 +191,8 @@ def test_help_lists_the_advanced_options(cli):
         ("feature_contrast=0", ["feature_contrast", "> 0"]),
         ("remove_loops=maybe", ["remove_loops", "0, 1, true or false", "'maybe'"]),
         ("convex_barrier=", ["convex_barrier"]),
-        ("neighbourhood=manhattan", ["neighbourhood", "geodesic or euclidean", "'manhattan'"]),
+        ("neighbourhood=manhattan", ["neighbourhood", "geodesic, euclidean or sphere", "'manhattan'"]),
+        ("plane_fit=faces", ["plane_fit", "vertices or area", "'faces'"]),
         ("planarity_one_ring=2", ["planarity_one_ring"]),
         ("threads=-1", ["threads", ">= 0"]),
     ],

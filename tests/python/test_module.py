@@ -285,6 +285,52 @@ def test_bad_keywords_raise_error(scan, kwargs, words):
         core.Mesh(V, F).segment(picks, step, **args)
 
 
+def test_advanced_options_are_listed_with_their_defaults():
+    opts = core.advanced_options()
+    names = [o["name"] for o in opts]
+    assert len(names) == len(set(names))
+    for name in ["tau", "epsilon", "q_samples", "exact_q", "neighbourhood", "plane_fit", "remove_loops",
+                 "nearest_resampling", "threads"]:
+        assert name in names, name
+    for o in opts:
+        assert set(o) == {"name", "type", "range", "help", "default"}
+        assert o["type"] in ("number", "integer", "boolean", "choice")
+        assert isinstance(o["default"], {"number": float, "integer": int, "boolean": bool, "choice": str}[o["type"]])
+    assert {o["name"]: o["default"] for o in opts}["tau"] == 0.2
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    (dict(bogus=1), TypeError, ["bogus", "advanced options", "tau"]),
+    (dict(tau=1.5), core.Error, ["tau", "(0, 1)"]),
+    (dict(tau="0.2"), core.Error, ["tau", "number"]),
+    (dict(q_samples=2.5), core.Error, ["q_samples", "int"]),
+    (dict(q_samples=True), core.Error, ["q_samples", "int"]),
+    (dict(exact_q=1), core.Error, ["exact_q", "True or False"]),
+    (dict(neighbourhood="manhattan"), core.Error, ["neighbourhood", "geodesic", "sphere", "manhattan"]),
+    (dict(plane_fit=3), core.Error, ["plane_fit", "str"]),
+])
+def test_bad_advanced_options(scan, kwargs, error, words):
+    V, F, picks, _, h, _ = scan
+    for call in (lambda: core.segment(V, F, picks, h, **kwargs), lambda: core.Mesh(V, F).segment(picks, h, **kwargs)):
+        with pytest.raises(error) as e:
+            call()
+        message = str(e.value)
+        assert "\n" not in message
+        for w in words:
+            assert w in message, (w, message)
+
+
+def test_advanced_options_reach_the_engine(scan, disk_result):
+    V, F, picks, _, h, _ = scan
+    r = core.segment(V, F, picks, h, progress=deadline(), tau=0.25, q_samples=7, exact_q=True,
+                     neighbourhood="sphere", plane_fit="area", threads=1)
+    p = r["parameters"]
+    assert p["tau"] == 0.25 and p["q_samples"] == 7 and p["exact_q"] is True and p["threads"] == 1
+    assert p["neighbourhood"] == "sphere" and p["plane_fit"] == "area"
+    assert disk_result["parameters"]["neighbourhood"] == "geodesic"  # the defaults, reported
+    assert r["relief_vertices"] != disk_result["relief_vertices"] or r["contour"] != disk_result["contour"]
+
+
 def test_keywords_are_keyword_only(scan):
     V, F, picks, _, h, _ = scan
     with pytest.raises(TypeError):

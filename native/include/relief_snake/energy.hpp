@@ -21,10 +21,13 @@ double normalise_alpha(double l);
 double normalise_beta(double l, double max_turn_degrees);
 
 /// The relief-step feature energy E_f^3 (Eqn. 8) with q_i searched over
-/// (1 +- epsilon) h along the inward direction (Section 5.3.3).
+/// (1 +- epsilon) h along the inward direction (Section 5.3.3): at q_samples
+/// evenly spaced points (the paper's "small set of candidate positions"), or,
+/// with exact_q, over the whole stretch (the minimum of the piecewise-linear
+/// P^ along it, found at its edge crossings and ends).
 class FeatureEnergy {
  public:
-  FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples);
+  FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples, bool exact_q = false);
   /// E_f at x, with q searched along `inward` from x; gamma applied by the caller.
   /// Returns (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma).
   double unscaled(const SurfacePoint& x, const Vec3& inward);
@@ -41,11 +44,17 @@ class FeatureEnergy {
   void mark();
   /// The q found by the last unscaled() call (for tests and drawing).
   const SurfacePoint& last_q() const { return last_q_; }
+  PlanarityField& planarity() { return planarity_; }
   /// Also penalise P^(x) < P^(q) (returns -(P^(x) - P^(q))^2 there). Not in the paper.
   void set_convex_barrier(bool on) { convex_barrier_ = on; }
 
  private:
+  /// Where q is searched for x: the sample points, or the stretch's crossings and ends.
+  void q_candidates(const SurfacePoint& x, const Vec3& inward, std::vector<SurfacePoint>* out) const;
+
   PlanarityField& planarity_;
+  bool exact_q_ = false;
+  double q_from_ = 0, q_to_ = 0;  // the searched stretch, (1 -+ epsilon) h
   std::vector<double> distances_;
   std::vector<std::vector<SurfacePoint>> samples_;  // per point of a batch
   std::vector<int> vertices_;                       // the batch's face corners

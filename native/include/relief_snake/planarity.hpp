@@ -7,24 +7,41 @@
 #include <vector>
 
 #include "relief_snake/mesh.hpp"
+#include "relief_snake/moment_tree.hpp"
 #include "relief_snake/surface_point.hpp"
 
 namespace relief_snake {
 
-/// Which neighbours of v the plane of P(v) is fitted to.
+/// Which part of the surface around v the plane of P(v) is fitted to.
 enum class Neighbourhood {
   Geodesic,   ///< within geodesic distance h (the paper): local fast marching
   Euclidean,  ///< within straight distance h and connected to v inside that ball (not in the paper; ~10x cheaper)
+  /// Within straight distance h, on v's component, facing v's side (normals within 120
+  /// degrees of v's), summed through a MomentTree: the cost grows with the sphere's
+  /// boundary, not its content (not in the paper).
+  Sphere,
+};
+
+/// What the plane is fitted to.
+enum class PlaneFit {
+  Vertices,  ///< the neighbouring vertices, one unit weight each (the paper; v itself excluded)
+  /// The neighbourhood's surface, weighted by area: faces whose corners are all in the
+  /// neighbourhood (Geodesic, Euclidean) or the surface inside the sphere (Sphere). Does not
+  /// depend on how densely each part was sampled, e.g. a step wall with no vertices on it
+  /// (not in the paper).
+  Area,
 };
 
 struct PlanarityOptions {
   double radius = 0;          ///< geodesic neighbourhood radius: the step height h
   double sigma_s = 0;         ///< bilateral similarity sigma; <= 0: estimate (see PlanarityField::estimate_sigma_s)
-  /// Always count the one-ring among the neighbours, even beyond distance h: a
-  /// scanned vertical step of height ~h has no vertices on its wall, so the ball
-  /// alone would never see the top from the foot (not in the paper).
+  /// Always count the one-ring among the neighbours (with PlaneFit::Area: v's own
+  /// faces), even beyond distance h: a scanned vertical step of height ~h has no
+  /// vertices on its wall, so the ball alone would never see the top from the foot
+  /// (not in the paper).
   bool include_one_ring = true;
   Neighbourhood neighbourhood = Neighbourhood::Geodesic;
+  PlaneFit fit = PlaneFit::Vertices;
   /// Threads for prefetch_*(): 0 = one per hardware thread, 1 = the caller only.
   /// Results do not depend on it.
   int threads = 0;
@@ -34,12 +51,12 @@ class WorkerPool;
 
 /// Planarity P(v) and filtered planarity P^(v) of a mesh for one radius h.
 ///
-/// P(v) = (c - v) . n for the least-squares plane (c, n) through the vertices
-/// within geodesic distance h of v (v itself excluded; at least the one-ring),
-/// with n oriented like the vertex normal. P > 0 where v lies below the plane of
-/// its neighbours (a concave crease such as the foot of a relief step), P < 0 at
-/// convex creases (the top edge of the step). Geodesic distances come from a
-/// local fast-marching front limited to radius h.
+/// P(v) = (c - v) . n for the least-squares plane (c, n) of v's neighbourhood
+/// (options: by default the vertices within geodesic distance h of v, v itself
+/// excluded, at least the one-ring), with n oriented like the vertex normal.
+/// P > 0 where v lies below the plane of its neighbours (a concave crease such as
+/// the foot of a relief step), P < 0 at convex creases (the top edge of the step).
+/// Geodesic distances come from a local fast-marching front limited to radius h.
 ///
 /// P^(v) (Eqn. 6 with P(v') in the numerator) averages P over v and its
 /// two-ring with weights W_c(|v - v'|) W_s(P(v) - P(v')), sigma_c = half the
@@ -50,7 +67,9 @@ class WorkerPool;
 /// one thread at a time.
 class PlanarityField {
  public:
-  PlanarityField(const Mesh& mesh, const PlanarityOptions& options);
+  /// tree: a MomentTree of this mesh to reuse for Neighbourhood::Sphere (it does not
+  /// depend on h); built here when missing or of the wrong kind.
+  PlanarityField(const Mesh& mesh, const PlanarityOptions& options, std::shared_ptr<const MomentTree> tree = nullptr);
   ~PlanarityField();
 
   double raw(int v);        ///< P(v)
@@ -79,6 +98,11 @@ class PlanarityField {
   double sigma_s() const { return sigma_s_; }
   double radius() const { return options_.radius; }
   const Mesh& mesh() const { return mesh_; }
+  const PlanarityOptions& options() const { return options_; }
+  /// The MomentTree in use (Neighbourhood::Sphere), or null.
+  const std::shared_ptr<const MomentTree>& tree() const { return tree_; }
+  /// The kind of MomentTree elements a fit needs.
+  static MomentTree::Elements tree_elements(PlaneFit fit);
 
   /// Number of vertices whose P (resp. P^) has been computed so far.
   std::size_t raw_count() const { return raw_count_; }
@@ -95,6 +119,8 @@ class PlanarityField {
   };
   Scratch& scratch(int worker);  // allocates on first use
   double compute_raw(int v, Scratch& scratch) const;
+  /// P(v) against the plane of its one-ring (h smaller than the edges).
+  double one_ring_planarity(int v) const;
   double compute_filtered(int v);
   void check_vertex(int v) const;
   /// Fast marching from v up to radius(); fills scratch.ball.
@@ -112,6 +138,7 @@ class PlanarityField {
   std::size_t raw_count_ = 0, filtered_count_ = 0;
   std::vector<Scratch> scratch_;        // one per worker
   std::unique_ptr<WorkerPool> pool_;    // created by the first prefetch that needs it
+  std::shared_ptr<const MomentTree> tree_;  // Neighbourhood::Sphere
   std::vector<int> ring_, needed_, batch_;  // scratch for filtered() and prefetch_*()
 };
 

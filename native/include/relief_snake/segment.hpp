@@ -27,6 +27,8 @@ struct Options {
   double tau = 0.2;                ///< movement step, fraction of the local segment length
   double epsilon = 0.2;            ///< q_i searched over (1 +- epsilon) h
   int q_samples = 5;               ///< candidate q_i positions across that range
+  /// Search q_i over the whole (1 +- epsilon) h stretch instead of q_samples points (not in the paper).
+  bool exact_q = false;
   double max_turn_degrees = 160;   ///< snaxels turning more than this are removed
   int lock_interval = 10;          ///< every this many iterations, lock snaxels that moved < 2 tau l
   int max_iterations = 3000;       ///< cap per phase
@@ -37,8 +39,12 @@ struct Options {
   bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
   bool convex_barrier = false;     ///< penalise sitting on the step's top edge (not in the paper)
   bool remove_loops = true;        ///< cut off loops where the snake crosses itself (not in the paper)
+  /// New snaxels (splits, merges, the refinement's subdivision) at the surface point nearest the
+  /// chord between their neighbours, instead of the end of a straight surface walk along it.
+  bool nearest_resampling = true;
   /// Planarity neighbourhoods (see PlanarityOptions). Changing either recomputes the planarity.
   Neighbourhood neighbourhood = Neighbourhood::Geodesic;
+  PlaneFit plane_fit = PlaneFit::Vertices;  ///< fit the plane to the vertices (paper) or to the surface area
   bool planarity_one_ring = true;  ///< the one-ring always counts as neighbours (not in the paper)
 };
 

@@ -59,6 +59,14 @@ class Snake {
   void subdivide(double l);
   /// Clears moved/locked state for a new phase.
   void reset_state();
+  /// Where splits, merges and subdivide() put new snaxels: nearest the chord (true,
+  /// the default) or at the end of a straight surface walk (see surface_between()).
+  void set_nearest_resampling(bool on) { nearest_resampling_ = on; }
+
+  /// True if every snaxel lies within `tolerance` of `old` (a polyline of this
+  /// snake, closed or open like it, e.g. an earlier polyline()): the shape has not
+  /// changed, whichever snaxels moved along it or were resampled.
+  bool within(const std::vector<Vec3>& old, double tolerance) const;
 
   std::vector<Vec3> polyline() const;
   std::vector<SurfacePoint> points() const;
@@ -71,15 +79,16 @@ class Snake {
   const Mesh& mesh_;
   std::vector<Snaxel> snaxels_;
   bool closed_, inside_left_;
+  bool nearest_resampling_ = true;
 };
 
-/// The surface point about halfway between a and b (a straight walk from a
-/// towards b for half their distance).
-SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b);
-/// Points on the surface between a and b at fractions t_k of their distance
-/// (straight walk from a towards b).
+/// Points on the surface between a and b at fractions t_k of their distance: the
+/// surface points nearest the chord points a + t_k (b - a) (nearest = true), or the
+/// ends of straight surface walks from a towards b (nearest = false).
 std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b,
-                                          const std::vector<double>& fractions);
+                                          const std::vector<double>& fractions, bool nearest = true);
+/// surface_between() at the fraction 0.5.
+SurfacePoint surface_midpoint(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b, bool nearest = true);
 
 /// If p lies on a mesh boundary edge, sets (*face, *edge) to it (edge = opposite corner) and returns true.
 bool boundary_edge_of(const Mesh& mesh, const SurfacePoint& p, int* face, int* edge);

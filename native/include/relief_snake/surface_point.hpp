@@ -56,4 +56,18 @@ Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, do
 Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
                   const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples);
 
+/// The same walk from distance `from` to `to` (0 <= from <= to): *points gets every
+/// edge crossing in that stretch and its two ends (those reached before a boundary),
+/// in no particular order. A per-vertex value interpolated linearly in each face
+/// takes its extremes over the stretch at these points.
+Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double from, double to,
+                  std::vector<SurfacePoint>* points);
+
+/// The point of the surface nearest to `target`, searched among the faces reachable
+/// from start's face through faces that come within `radius` of the target (so
+/// radius >= |position(start) - target| finds it unless the surface folds away).
+/// scratch: optional reusable buffer.
+SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, const Vec3& target, double radius,
+                                std::vector<int>* scratch = nullptr);
+
 }  // namespace relief_snake

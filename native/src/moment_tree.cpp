@@ -1,0 +1,232 @@
+#include "relief_snake/moment_tree.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace relief_snake {
+
+namespace {
+
+constexpr int kLeafSize = 8;
+
+// Spreads the low 10 bits of x to every third bit (Morton code helper).
+unsigned spread_bits(unsigned x) {
+  x &= 0x3ff;
+  x = (x | (x << 16)) & 0x030000ff;
+  x = (x | (x << 8)) & 0x0300f00f;
+  x = (x | (x << 4)) & 0x030c30c3;
+  x = (x | (x << 2)) & 0x09249249;
+  return x;
+}
+
+int leading_zeros(unsigned x) { return x == 0 ? 32 : __builtin_clz(x); }
+
+double cone_angle(double c) { return std::acos(std::clamp(c, -1.0, 1.0)); }
+
+// Squared distances from p to the nearest and the farthest point of the box [lo, hi].
+double min_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  return (p.cwiseMax(lo).cwiseMin(hi) - p).squaredNorm();
+}
+double max_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  return (p - lo).cwiseAbs().cwiseMax((p - hi).cwiseAbs()).squaredNorm();
+}
+
+}  // namespace
+
+Vec3 MomentTree::element_normal(int e) const {
+  return elements_ == Elements::Faces ? mesh_.face_normal(e) : mesh_.vertex_normal(e);
+}
+
+int MomentTree::element_component(int e) const {
+  return mesh_.component(elements_ == Elements::Faces ? mesh_.face_vertex(e, 0) : e);
+}
+
+MomentTree::MomentTree(const Mesh& mesh, Elements elements) : mesh_(mesh), elements_(elements) {
+  const int n = elements == Elements::Faces ? mesh.n_faces() : mesh.n_vertices();
+  if (n == 0) return;
+  std::vector<Vec3> centre(n);
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (int e = 0; e < n; ++e) {
+    if (elements == Elements::Faces)
+      centre[e] = (mesh.position(mesh.face_vertex(e, 0)) + mesh.position(mesh.face_vertex(e, 1)) +
+                   mesh.position(mesh.face_vertex(e, 2))) / 3.0;
+    else
+      centre[e] = mesh.position(e);
+    lo = lo.cwiseMin(centre[e]);
+    hi = hi.cwiseMax(centre[e]);
+  }
+  origin_ = 0.5 * (lo + hi);
+  const Vec3 extent = (hi - lo).cwiseMax(1e-300);
+  // Morton order: elements near in space are near in the order, so every index
+  // range of the tree is a compact box.
+  std::vector<std::pair<unsigned, int>> keyed(n);
+  for (int e = 0; e < n; ++e) {
+    const Vec3 t = ((centre[e] - lo).array() / extent.array()).cwiseMax(0.0).cwiseMin(1.0) * 1023.0;
+    keyed[e] = {(spread_bits(static_cast<unsigned>(t.x())) << 2) | (spread_bits(static_cast<unsigned>(t.y())) << 1) |
+                    spread_bits(static_cast<unsigned>(t.z())),
+                e};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  order_.resize(n);
+  std::vector<unsigned> codes(n);
+  for (int k = 0; k < n; ++k) {
+    order_[k] = keyed[k].second;
+    codes[k] = keyed[k].first;
+  }
+  nodes_.reserve(2 * (n / kLeafSize + 2));
+  build(0, n, codes);
+}
+
+int MomentTree::build(int begin, int end, const std::vector<unsigned>& codes) {
+  const int index = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  nodes_[index].begin = begin;
+  nodes_[index].end = end;
+  if (end - begin <= kLeafSize) {
+    finish_leaf(nodes_[index]);
+    return index;
+  }
+  // Split where the highest differing Morton bit changes (a spatial split);
+  // a run of equal codes is cut in the middle.
+  int split = (begin + end) / 2;
+  const unsigned first = codes[begin], last = codes[end - 1];
+  if (first != last) {
+    const int common = leading_zeros(first ^ last);
+    int lo = begin, hi = end - 1;  // codes[lo] shares more than `common` leading bits with first, codes[hi] not
+    while (lo + 1 < hi) {
+      const int mid = lo + (hi - lo) / 2;
+      if (leading_zeros(first ^ codes[mid]) > common) lo = mid;
+      else hi = mid;
+    }
+    split = hi;
+  }
+  const int left = build(begin, split, codes);
+  const int right = build(split, end, codes);
+  Node& node = nodes_[index];  // nodes_ may have grown: take the reference now
+  node.left = left;
+  node.right = right;
+  finish_inner(node, nodes_[left], nodes_[right]);
+  return index;
+}
+
+void MomentTree::finish_leaf(Node& node) const {
+  node.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  node.hi = -node.lo;
+  Vec3 normal_sum = Vec3::Zero();
+  node.component = element_component(order_[node.begin]);
+  for (int k = node.begin; k < node.end; ++k) {
+    const int e = order_[k];
+    if (elements_ == Elements::Faces) {
+      const Vec3 a = mesh_.position(mesh_.face_vertex(e, 0)), b = mesh_.position(mesh_.face_vertex(e, 1)),
+                 c = mesh_.position(mesh_.face_vertex(e, 2));
+      node.lo = node.lo.cwiseMin(a).cwiseMin(b).cwiseMin(c);
+      node.hi = node.hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
+      node.moments.add_triangle(a - origin_, b - origin_, c - origin_);
+      normal_sum += mesh_.face_area(e) * mesh_.face_normal(e);
+    } else {
+      const Vec3& p = mesh_.position(e);
+      node.lo = node.lo.cwiseMin(p);
+      node.hi = node.hi.cwiseMax(p);
+      node.moments.add_point(p - origin_);
+      normal_sum += mesh_.vertex_normal(e);
+    }
+    if (element_component(e) != node.component) node.component = -1;
+  }
+  const double len = normal_sum.norm();
+  node.axis = len > 0 ? Vec3(normal_sum / len) : Vec3::UnitZ();
+  node.cone_cos = len > 0 ? 1.0 : -1.0;
+  if (len > 0)
+    for (int k = node.begin; k < node.end; ++k) node.cone_cos = std::min(node.cone_cos, element_normal(order_[k]).dot(node.axis));
+}
+
+void MomentTree::finish_inner(Node& node, const Node& a, const Node& b) const {
+  node.lo = a.lo.cwiseMin(b.lo);
+  node.hi = a.hi.cwiseMax(b.hi);
+  node.moments = a.moments;
+  node.moments.add(b.moments);
+  node.component = a.component == b.component ? a.component : -1;
+  // A cone holding both children's cones (conservative).
+  const Vec3 sum = a.moments.weight * a.axis + b.moments.weight * b.axis;
+  const double len = sum.norm();
+  if (!(len > 0) || a.cone_cos <= -1 || b.cone_cos <= -1) {
+    node.axis = Vec3::UnitZ();
+    node.cone_cos = -1;
+    return;
+  }
+  node.axis = sum / len;
+  const double spread =
+      std::max(cone_angle(a.axis.dot(node.axis)) + cone_angle(a.cone_cos), cone_angle(b.axis.dot(node.axis)) + cone_angle(b.cone_cos));
+  node.cone_cos = spread >= M_PI ? -1.0 : std::cos(spread);
+}
+
+void MomentTree::add_cut(const Vec3& a, const Vec3& b, const Vec3& c, const Query& q, double r2,
+                         PlaneMoments* out) const {
+  const Vec3 g = (a + b + c) / 3.0;
+  if ((g - q.center).squaredNorm() <= r2) out->add_triangle(a - origin_, b - origin_, c - origin_);
+}
+
+void MomentTree::add_element(int e, const Query& q, double r2, PlaneMoments* out) const {
+  if (q.component >= 0 && element_component(e) != q.component) return;
+  if (element_normal(e).dot(q.facing) < q.min_facing) return;
+  if (elements_ == Elements::Faces) {
+    add_cut(mesh_.position(mesh_.face_vertex(e, 0)), mesh_.position(mesh_.face_vertex(e, 1)),
+            mesh_.position(mesh_.face_vertex(e, 2)), q, r2, out);
+  } else if ((mesh_.position(e) - q.center).squaredNorm() <= r2) {
+    out->add_point(mesh_.position(e) - origin_);
+  }
+}
+
+PlaneMoments MomentTree::sphere(const Query& q) const {
+  PlaneMoments sum;
+  if (nodes_.empty()) return sum;
+  const double r2 = q.radius * q.radius;
+  const double facing_norm = q.facing.norm();
+  const bool test_facing = facing_norm > 0 && q.min_facing > -1;
+  const Vec3 facing = test_facing ? Vec3(q.facing / facing_norm) : Vec3::Zero();
+  Query leaf_query = q;
+  leaf_query.facing = facing;
+  if (!test_facing) leaf_query.min_facing = -2;  // every normal passes
+  const double min_angle_facing = test_facing ? cone_angle(q.min_facing) : M_PI;
+
+  std::array<int, 128> stack;  // depth is ~log2(n / 8) + a few: far below 128
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (q.component >= 0 && node.component >= 0 && node.component != q.component) continue;
+    if (min_distance2(q.center, node.lo, node.hi) > r2) continue;
+    bool all_facing = true;
+    if (test_facing) {
+      // Angles between `facing` and the normals in the cone: [alpha - spread, alpha + spread].
+      const double alpha = cone_angle(node.axis.dot(facing)), spread = node.cone_cos <= -1 ? M_PI : cone_angle(node.cone_cos);
+      if (alpha - spread > min_angle_facing) continue;  // every normal faces away
+      all_facing = alpha + spread <= min_angle_facing;
+    }
+    const bool one_component = q.component < 0 || node.component == q.component;
+    if (one_component && all_facing && max_distance2(q.center, node.lo, node.hi) <= r2) {
+      sum.add(node.moments);  // wholly inside: take the node's sums
+      continue;
+    }
+    if (one_component && all_facing && (node.hi - node.lo).squaredNorm() <= q.grain * q.grain) {
+      // Small enough to count like a face: whole, if its centroid is inside.
+      if ((node.moments.first / node.moments.weight + origin_ - q.center).squaredNorm() <= r2) sum.add(node.moments);
+      continue;
+    }
+    if (node.left < 0) {
+      for (int k = node.begin; k < node.end; ++k) add_element(order_[k], leaf_query, r2, &sum);
+      continue;
+    }
+    stack[top++] = node.left;
+    stack[top++] = node.right;
+  }
+  return sum.shifted(q.center - origin_);
+}
+
+std::size_t MomentTree::memory_bytes() const {
+  return nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(int);
+}
+
+}  // namespace relief_snake

@@ -1,0 +1,178 @@
+#include "relief_snake/option_table.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <sstream>
+
+#include "relief_snake/error.hpp"
+
+namespace relief_snake {
+
+namespace {
+
+struct Row {
+  OptionInfo info;
+  std::function<void(Options&, const std::string&)> set;  // text already known to be well-formed for the type
+  std::function<std::string(const Options&)> json;
+};
+
+[[noreturn]] void bad_value(const OptionInfo& info, const std::string& text) {
+  throw Error(std::string("option ") + info.name + " must be " + info.range + ", got '" + text + "'");
+}
+
+// The shortest decimal text that reads back as exactly x ("0.2", not "0.20000000000000001").
+std::string number_json(double x) {
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::ostringstream s;
+    s.precision(digits);
+    s << x;
+    if (std::strtod(s.str().c_str(), nullptr) == x) return s.str();
+  }
+  return std::to_string(x);
+}
+
+Row number(const char* name, double Options::*field, const char* range, bool (*valid)(double), const char* help) {
+  const OptionInfo info{name, OptionType::Number, range, help};
+  return {info,
+          [=](Options& o, const std::string& text) {
+            errno = 0;
+            char* end = nullptr;
+            const double x = std::strtod(text.c_str(), &end);
+            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(x) || !valid(x))
+              bad_value(info, text);
+            o.*field = x;
+          },
+          [=](const Options& o) { return number_json(o.*field); }};
+}
+
+Row integer(const char* name, int Options::*field, const char* range, bool (*valid)(long long), const char* help) {
+  const OptionInfo info{name, OptionType::Integer, range, help};
+  return {info,
+          [=](Options& o, const std::string& text) {
+            errno = 0;
+            char* end = nullptr;
+            const long long n = std::strtoll(text.c_str(), &end, 10);
+            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || n > 100000000 || !valid(n))
+              bad_value(info, text);
+            o.*field = static_cast<int>(n);
+          },
+          [=](const Options& o) { return std::to_string(o.*field); }};
+}
+
+Row boolean(const char* name, bool Options::*field, const char* help) {
+  const OptionInfo info{name, OptionType::Boolean, "0, 1, true or false", help};
+  return {info,
+          [=](Options& o, const std::string& text) {
+            if (text == "1" || text == "true") o.*field = true;
+            else if (text == "0" || text == "false") o.*field = false;
+            else bad_value(info, text);
+          },
+          [=](const Options& o) { return std::string(o.*field ? "true" : "false"); }};
+}
+
+Row neighbourhood(const char* name, Neighbourhood Options::*field, const char* help) {
+  const OptionInfo info{name, OptionType::Choice, "geodesic, euclidean or sphere", help};
+  return {info,
+          [=](Options& o, const std::string& text) {
+            if (text == "geodesic") o.*field = Neighbourhood::Geodesic;
+            else if (text == "euclidean") o.*field = Neighbourhood::Euclidean;
+            else if (text == "sphere") o.*field = Neighbourhood::Sphere;
+            else bad_value(info, text);
+          },
+          [=](const Options& o) {
+            switch (o.*field) {
+              case Neighbourhood::Geodesic: return std::string("\"geodesic\"");
+              case Neighbourhood::Euclidean: return std::string("\"euclidean\"");
+              case Neighbourhood::Sphere: return std::string("\"sphere\"");
+            }
+            return std::string("\"?\"");
+          }};
+}
+
+Row plane_fit(const char* name, PlaneFit Options::*field, const char* help) {
+  const OptionInfo info{name, OptionType::Choice, "vertices or area", help};
+  return {info,
+          [=](Options& o, const std::string& text) {
+            if (text == "vertices") o.*field = PlaneFit::Vertices;
+            else if (text == "area") o.*field = PlaneFit::Area;
+            else bad_value(info, text);
+          },
+          [=](const Options& o) {
+            return std::string(o.*field == PlaneFit::Vertices ? "\"vertices\"" : "\"area\"");
+          }};
+}
+
+const std::vector<Row>& rows() {
+  static const std::vector<Row> table = {
+      number("tau", &Options::tau, "in (0, 1)", [](double x) { return x > 0 && x < 1; },
+             "movement step, fraction of the local segment length (paper: 0.2)"),
+      number("epsilon", &Options::epsilon, "in [0, 1)", [](double x) { return x >= 0 && x < 1; },
+             "q_i is searched over (1 +- epsilon) h (paper: 0.2)"),
+      integer("q_samples", &Options::q_samples, "a whole number >= 1", [](long long n) { return n >= 1; },
+              "candidate q_i positions across that range"),
+      boolean("exact_q", &Options::exact_q,
+              "search q_i over the whole (1 +- epsilon) h stretch instead of q_samples points (not in the paper)"),
+      number("max_turn_degrees", &Options::max_turn_degrees, "in (0, 180]", [](double x) { return x > 0 && x <= 180; },
+             "snaxels turning more than this are removed (paper: 160)"),
+      integer("lock_interval", &Options::lock_interval, "a whole number >= 1", [](long long n) { return n >= 1; },
+              "oscillation lock check every this many iterations (paper: 10)"),
+      number("feature_contrast", &Options::feature_contrast, "> 0", [](double x) { return x > 0; },
+             "planarity contrast, in units of h, that scores E_f = -1 at l = h (normalisation of gamma)"),
+      boolean("scale_feature_with_spacing", &Options::scale_feature_with_spacing,
+              "gamma scales with 1/l between phases, like alpha"),
+      boolean("convex_barrier", &Options::convex_barrier,
+              "also penalise P^(v) < P^(q) (experimental, not in the paper)"),
+      boolean("remove_loops", &Options::remove_loops, "cut off loops where the snake crosses itself (not in the paper)"),
+      boolean("nearest_resampling", &Options::nearest_resampling,
+              "new snaxels at the surface point nearest the chord, not at the end of a surface walk along it"),
+      neighbourhood("neighbourhood", &Options::neighbourhood,
+                    "planarity neighbourhood: geodesic h-ball (paper), straight-distance h-ball connected to v, "
+                    "or every part of the surface within straight distance h facing v's side (a moment tree)"),
+      plane_fit("plane_fit", &Options::plane_fit,
+                "planarity plane fitted to the neighbourhood's vertices (paper) or to its surface area"),
+      boolean("planarity_one_ring", &Options::planarity_one_ring,
+              "the one-ring always counts as planarity neighbours (not in the paper)"),
+      integer("threads", &Options::threads, "a whole number >= 0 (0: all cores)",
+              [](long long n) { return n >= 0 && n <= 4096; }, "threads for the planarity batches; results do not depend on it"),
+  };
+  return table;
+}
+
+const Row* find(const std::string& name) {
+  for (const Row& r : rows())
+    if (name == r.info.name) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+const std::vector<OptionInfo>& advanced_options() {
+  static const std::vector<OptionInfo> infos = [] {
+    std::vector<OptionInfo> out;
+    for (const Row& r : rows()) out.push_back(r.info);
+    return out;
+  }();
+  return infos;
+}
+
+std::string advanced_option_names() {
+  std::string names;
+  for (const Row& r : rows()) names += (names.empty() ? "" : ", ") + std::string(r.info.name);
+  return names;
+}
+
+void set_advanced_option(Options* options, const std::string& name, const std::string& value) {
+  const Row* row = find(name);
+  if (!row) throw Error("unknown option '" + name + "'; valid names: " + advanced_option_names());
+  row->set(*options, value);
+}
+
+std::string advanced_option_json(const Options& options, const std::string& name) {
+  const Row* row = find(name);
+  if (!row) throw Error("unknown option '" + name + "'; valid names: " + advanced_option_names());
+  return row->json(options);
+}
+
+}  // namespace relief_snake

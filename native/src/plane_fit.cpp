@@ -1,0 +1,58 @@
+#include "relief_snake/plane_fit.hpp"
+
+#include <Eigen/Eigenvalues>
+
+namespace relief_snake {
+
+void PlaneMoments::add_point(const Vec3& x, double w) {
+  weight += w;
+  first += w * x;
+  second.noalias() += w * (x * x.transpose());
+}
+
+void PlaneMoments::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double area = 0.5 * (b - a).cross(c - a).norm();
+  if (!(area > 0)) return;
+  const Vec3 s = a + b + c;
+  weight += area;
+  first += (area / 3.0) * s;
+  // Uniform density over the triangle: integral of x x^T dA = A/12 (sum_i p_i p_i^T + s s^T).
+  second.noalias() += (area / 12.0) * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+}
+
+void PlaneMoments::add(const PlaneMoments& o) {
+  weight += o.weight;
+  first += o.first;
+  second += o.second;
+}
+
+PlaneMoments PlaneMoments::shifted(const Vec3& o) const {
+  PlaneMoments out;
+  out.weight = weight;
+  out.first = first - weight * o;
+  // sum w (x - o)(x - o)^T = second - first o^T - o first^T + w o o^T
+  out.second = second - first * o.transpose() - o * first.transpose() + weight * (o * o.transpose());
+  return out;
+}
+
+double planarity_about_vertex(const PlaneMoments& m, const Vec3& vn) {
+  if (!(m.weight > 0)) return 0.0;
+  const Vec3 centroid = m.first / m.weight;  // relative to v
+  const Eigen::Matrix3d cov = m.second / m.weight - centroid * centroid.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov);
+  const Vec3 evals = solver.eigenvalues();  // increasing
+  if (!(evals(2) > 0)) return 0.0;          // every point at the centroid
+  Vec3 normal;
+  // Collinear points leave the normal undetermined: use the surface's. (The closed-form
+  // solver's rounding puts a zero eigenvalue at about 1e-8 of the largest.)
+  if (evals(1) <= 1e-6 * evals(2)) {
+    normal = vn;
+  } else {
+    normal = solver.eigenvectors().col(0);
+    if (normal.dot(vn) < 0) normal = -normal;
+  }
+  return centroid.dot(normal);
+}
+
+}  // namespace relief_snake
