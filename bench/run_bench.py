@@ -73,9 +73,16 @@ VARIANTS = [
     ("faithful", ["remove_loops=0", "planarity_one_ring=0"]),
     ("no-loop-removal", ["remove_loops=0"]),
     ("no-one-ring", ["planarity_one_ring=0"]),
-    ("euclidean", ["neighbourhood=euclidean"]),
-    ("convex-barrier", ["convex_barrier=1"]),
+    ("walk-resampling", ["nearest_resampling=0"]),
     ("exact-q", ["exact_q=1"]),
+    ("area", ["plane_fit=area"]),
+    ("euclidean", ["neighbourhood=euclidean"]),
+    ("euclidean-area", ["neighbourhood=euclidean", "plane_fit=area"]),
+    ("sphere-area", ["neighbourhood=sphere", "plane_fit=area"]),
+    ("exact-q+area", ["exact_q=1", "plane_fit=area"]),
+    ("exact-q+euclidean-area", ["exact_q=1", "neighbourhood=euclidean", "plane_fit=area"]),
+    ("exact-q+sphere-area", ["exact_q=1", "neighbourhood=sphere", "plane_fit=area"]),
+    ("convex-barrier", ["convex_barrier=1"]),
 ]
 
 

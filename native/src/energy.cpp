@@ -1,7 +1,12 @@
 #include "relief_snake/energy.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
+
+#include "relief_snake/error.hpp"
 
 namespace relief_snake {
 
@@ -44,75 +49,80 @@ FeatureEnergy::FeatureEnergy(PlanarityField& planarity, double h, double epsilon
   }
 }
 
-void FeatureEnergy::q_candidates(const SurfacePoint& x, const Vec3& inward, std::vector<SurfacePoint>* out) const {
-  if (exact_q_)
-    walk_stretch(planarity_.mesh(), x, inward, q_from_, q_to_, out);
-  else
-    walk_sampled(planarity_.mesh(), x, inward, distances_, out);
+void FeatureEnergy::trace(const SurfacePoint& x, const Vec3& inward, const double* offsets, int count,
+                          QTrace* out) const {
+  out->candidates = count;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int k = 0; k < count; ++k) {
+    out->offset[k] = offsets[k];
+    lo = std::min(lo, offsets[k]);
+    hi = std::max(hi, offsets[k]);
+  }
+  // Sample distances in increasing order; the walk tags each point with its index
+  // in this order, which is mapped back to (candidate, sample) below.
+  std::array<std::pair<double, int>, 3 * 64 + 6> wanted;
+  int n = 0;
+  if (exact_q_) {
+    for (int k = 0; k < count; ++k) {
+      wanted[n++] = {std::max(0.0, q_from_ + offsets[k]), -1};
+      wanted[n++] = {std::max(0.0, q_to_ + offsets[k]), -1};
+    }
+  } else {
+    const int q = static_cast<int>(distances_.size());
+    if (count * q > 3 * 64) throw Error("q_samples must be at most 64");
+    for (int k = 0; k < count; ++k)
+      for (int j = 0; j < q; ++j) wanted[n++] = {std::max(0.0, distances_[j] + offsets[k]), k * q + j};
+  }
+  std::sort(wanted.begin(), wanted.begin() + n);
+  std::array<double, 3 * 64 + 6> distances;
+  for (int i = 0; i < n; ++i) distances[i] = wanted[i].first;
+  const Walk w = walk_trace(planarity_.mesh(), x, inward, distances.data(), n, exact_q_ ? q_from_ + lo : 0,
+                            exact_q_ ? q_to_ + hi : -1, &out->points);
+  (void)w;
+  for (WalkPoint& p : out->points)
+    if (p.tag >= 0) p.tag = wanted[p.tag].second;
+}
+
+void FeatureEnergy::corners(const SurfacePoint* candidates, int count, const QTrace& trace,
+                            std::vector<int>* out) const {
+  const Mesh& mesh = planarity_.mesh();
+  auto add = [&](const SurfacePoint& p) {
+    if (!p.valid() || p.face >= mesh.n_faces()) return;  // evaluate() reports it
+    for (int k = 0; k < 3; ++k) out->push_back(mesh.face_vertex(p.face, k));
+  };
+  for (int k = 0; k < count; ++k) add(candidates[k]);
+  for (const WalkPoint& p : trace.points) add(p.point);
+}
+
+double FeatureEnergy::evaluate(const SurfacePoint& x, const QTrace& trace, int k, SurfacePoint* q) const {
+  const int samples = static_cast<int>(distances_.size());
+  const double lo = q_from_ + trace.offset[k] - 1e-12, hi = q_to_ + trace.offset[k] + 1e-12;
+  double q_value = std::numeric_limits<double>::infinity();
+  for (const WalkPoint& p : trace.points) {
+    const bool mine = exact_q_ ? (p.distance >= lo && p.distance <= hi) : (p.tag >= 0 && p.tag / samples == k);
+    if (!mine) continue;
+    const double value = planarity_.cached_filtered(p.point);
+    if (value < q_value) {
+      q_value = value;
+      if (q) *q = p.point;
+    }
+  }
+  if (q_value == std::numeric_limits<double>::infinity()) return 0;  // the mesh ends before the window
+  const double d = planarity_.cached_filtered(x) - q_value;
+  if (d > 0) return d * d;
+  // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
+  // is penalised instead of ignored, so it cannot slip past the step's top edge.
+  return convex_barrier_ ? -d * d : 0.0;
 }
 
 double FeatureEnergy::unscaled(const SurfacePoint& x, const Vec3& inward) {
-  double value = 0;
-  unscaled(&x, 1, inward, &value);
-  return value;
-}
-
-bool FeatureEnergy::exploring() const { return planarity_.raw_count() != mark_; }
-
-void FeatureEnergy::mark() { mark_ = planarity_.raw_count(); }
-
-void FeatureEnergy::prefetch(const std::vector<SurfacePoint>& points, const std::vector<Vec3>& inward) {
-  const Mesh& mesh = planarity_.mesh();
-  if (samples_.empty()) samples_.resize(1);
-  vertices_.clear();
-  auto corners = [&](const SurfacePoint& p) {
-    if (!p.valid() || p.face >= mesh.n_faces()) return;
-    for (int k = 0; k < 3; ++k) vertices_.push_back(mesh.face_vertex(p.face, k));
-  };
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    corners(points[i]);
-    q_candidates(points[i], inward[i], &samples_[0]);
-    for (const SurfacePoint& q : samples_[0]) corners(q);
-  }
-  planarity_.prefetch_filtered(vertices_);
-}
-
-void FeatureEnergy::unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out) {
-  const Mesh& mesh = planarity_.mesh();
-  if (static_cast<int>(samples_.size()) < count) samples_.resize(count);
-  // Gather every face corner first, so the missing planarity is one parallel batch.
-  vertices_.clear();
-  auto corners = [&](const SurfacePoint& p) {
-    if (!p.valid() || p.face >= mesh.n_faces()) return;  // filtered() reports it below
-    for (int k = 0; k < 3; ++k) vertices_.push_back(mesh.face_vertex(p.face, k));
-  };
-  for (int i = 0; i < count; ++i) {
-    q_candidates(xs[i], inward, &samples_[i]);
-    corners(xs[i]);
-    for (const SurfacePoint& q : samples_[i]) corners(q);
-  }
-  planarity_.prefetch_filtered(vertices_);
-
-  for (int i = 0; i < count; ++i) {
-    out[i] = 0;
-    if (samples_[i].empty()) continue;  // the mesh ends before (1 - eps) h: no step inside
-    double q_value = std::numeric_limits<double>::infinity();
-    for (const SurfacePoint& q : samples_[i]) {
-      const double value = planarity_.filtered(q);
-      if (value < q_value) {
-        q_value = value;
-        last_q_ = q;
-      }
-    }
-    const double d = planarity_.filtered(xs[i]) - q_value;
-    if (d > 0) {
-      out[i] = d * d;
-    } else if (convex_barrier_) {
-      // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
-      // is penalised instead of ignored, so it cannot slip past the step's top edge.
-      out[i] = -d * d;
-    }
-  }
+  QTrace t;
+  const double zero = 0;
+  trace(x, inward, &zero, 1, &t);
+  std::vector<int> vertices;
+  corners(&x, 1, t, &vertices);
+  planarity_.prefetch_filtered(vertices);
+  return evaluate(x, t, 0, &last_q_);
 }
 
 }  // namespace relief_snake

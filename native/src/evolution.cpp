@@ -1,6 +1,10 @@
 #include "relief_snake/evolution.hpp"
 
+#include <functional>
+#include <memory>
 #include <vector>
+
+#include "worker_pool.hpp"
 
 namespace relief_snake {
 
@@ -21,88 +25,167 @@ double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, double fe
   return phase.w_int * internal - phase.w_f * phase.gamma * feature_unscaled;
 }
 
-int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase) {
+// One snaxel's greedy step: its three candidates, the q line(s), the decision.
+struct GreedyProbe {
+  int i = 0;
+  Vec3 inward = Vec3::Zero();
+  double li = 0;
+  SurfacePoint candidate[3];  // stay, inside, outside
+  QTrace trace[3];            // interior snaxels: trace[0] for all three; open ends: one each
+  int traces = 0;             // 0: nothing to evaluate (no inward direction)
+  int decision = 0;           // 0 stay, 1 inside, 2 outside
+};
+
+namespace {
+
+// Below this many probes a colour class runs on the calling thread: waking the
+// workers costs more than the work.
+constexpr int kParallelProbes = 24;
+
+void parallel_for(WorkerPool* pool, int count, const std::function<void(int)>& task) {
+  if (!pool || pool->size() == 1 || count < kParallelProbes) {
+    for (int k = 0; k < count; ++k) task(k);
+    return;
+  }
+  pool->run(count, [&](int item, int) { task(item); });
+}
+
+}  // namespace
+
+struct GreedyWorkspace {
+  std::vector<GreedyProbe> probes;
+  std::vector<int> vertices;
+  std::vector<char> moved_before;
+  std::vector<int> indices;
+};
+
+
+int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase, WorkerPool* pool,
+                     GreedyWorkspace* workspace) {
+  std::unique_ptr<GreedyWorkspace> owned;
+  if (!workspace) {
+    owned = std::make_unique<GreedyWorkspace>();
+    workspace = owned.get();
+  }
+  GreedyWorkspace& w = *workspace;
   const Mesh& mesh = snake.mesh();
   const int n = snake.size();
-  std::vector<char> moved_before(n);
-  for (int i = 0; i < n; ++i) moved_before[i] = snake[i].moved;
+  w.moved_before.resize(n);
+  for (int i = 0; i < n; ++i) {
+    w.moved_before[i] = snake[i].moved;
+    snake[i].moved = false;
+  }
   auto evaluated = [&](int i) {
     // If it and its neighbours stood still last time, its energies are unchanged.
     const int ip = snake.prev(i), in = snake.next(i);
     return !snake[i].locked &&
-           (moved_before[i] || (ip >= 0 && moved_before[ip]) || (in >= 0 && moved_before[in]));
+           (w.moved_before[i] || (ip >= 0 && w.moved_before[ip]) || (in >= 0 && w.moved_before[in]));
   };
-  // While the snake is entering new territory (planarity was computed since
-  // the last iteration began), compute what this one will need as one parallel batch
-  // first. The candidates are within tau l of the snaxels, so their q samples
-  // fall mostly on the same faces.
-  const bool exploring = feature.exploring();
-  feature.mark();
-  if (phase.w_f != 0 && phase.gamma != 0 && exploring) {
-    std::vector<SurfacePoint> points;
-    std::vector<Vec3> inwards;
-    for (int i = 0; i < n; ++i) {
-      if (!evaluated(i) || snake.is_end(i)) continue;
-      const Vec3 inward = snake.inward(i);
-      if (inward.isZero()) continue;
-      points.push_back(snake[i].point);
-      inwards.push_back(inward);
-    }
-    feature.prefetch(points, inwards);
-  }
-  int moved = 0;
-  for (int i = 0; i < n; ++i) {
-    Snaxel& s = snake[i];
-    const bool evaluate = evaluated(i);
-    s.moved = false;
-    if (!evaluate) continue;
+  const bool use_feature = phase.w_f != 0 && phase.gamma != 0;
 
-    const Vec3 inward = snake.inward(i);
-    if (inward.isZero()) continue;
-    const double li = snake.local_length(i);
-    const double step = phase.tau * li;
-    SurfacePoint inside, outside;
-    if (snake.is_end(i)) {
-      // Open ends slide along the mesh boundary.
-      const SurfacePoint a = slide_along_boundary(mesh, s.point, step);
-      const SurfacePoint b = slide_along_boundary(mesh, s.point, -step);
-      const bool a_inside = (position(mesh, a) - s.position).dot(inward) >= 0;
-      inside = a_inside ? a : b;
-      outside = a_inside ? b : a;
-    } else {
-      inside = walk(mesh, s.point, inward, step).end;
-      outside = walk(mesh, s.point, -inward, step).end;
+  // Snaxels are visited in colour classes, every other snaxel at a time, so that no
+  // two snaxels of a class are neighbours: within a class the moves are independent
+  // and their evaluation runs in parallel, each seeing its neighbours' latest
+  // positions (as a sequential sweep would see one of them). An odd closed snake
+  // puts its last snaxel, neighbour of the first, in a class of its own. The result
+  // does not depend on the number of threads.
+  const int classes = snake.closed() && n % 2 == 1 ? 3 : 2;
+  int moved = 0;
+  for (int c = 0; c < classes; ++c) {
+    w.indices.clear();
+    for (int i = c == 2 ? n - 1 : c; i < n; i += 2) {
+      if (c == 0 && classes == 3 && i == n - 1) break;
+      if (evaluated(i)) w.indices.push_back(i);
+      if (c == 2) break;
     }
-    // Stay, inside, outside: one planarity batch for the three.
-    const SurfacePoint candidates[3] = {s.point, inside, outside};
-    double f[3] = {0, 0, 0};
-    if (phase.w_f != 0 && phase.gamma != 0) feature.unscaled(candidates, 3, inward, f);
-    const double e_stay = snaxel_energy(snake, i, s.point, f[0], phase);
-    double e_in = snaxel_energy(snake, i, inside, f[1], phase);
-    if (phase.w_d != 0)
-      e_in += phase.w_d * deflation_energy(phase.alpha, phase.beta, phase.tau, li, phase.gamma_sigma2);
-    const double e_out = snaxel_energy(snake, i, outside, f[2], phase);
-    if (e_in < e_stay && e_in <= e_out) {
-      snake.move(i, inside);
-    } else if (e_out < e_stay && e_out < e_in) {
-      snake.move(i, outside);
-    } else {
-      continue;
+    const int count = static_cast<int>(w.indices.size());
+    if (count == 0) continue;
+    if (static_cast<int>(w.probes.size()) < count) w.probes.resize(count);
+
+    // 1. Candidates and q lines (walks only: thread-safe).
+    parallel_for(pool, count, [&](int k) {
+      GreedyProbe& p = w.probes[k];
+      p.i = w.indices[k];
+      p.decision = 0;
+      p.traces = 0;
+      const Snaxel& s = snake[p.i];
+      p.inward = snake.inward(p.i);
+      if (p.inward.isZero()) return;
+      p.li = snake.local_length(p.i);
+      const double step = phase.tau * p.li;
+      p.candidate[0] = s.point;
+      if (snake.is_end(p.i)) {
+        // Open ends slide along the mesh boundary; each candidate gets its own q line.
+        const SurfacePoint a = slide_along_boundary(mesh, s.point, step);
+        const SurfacePoint b = slide_along_boundary(mesh, s.point, -step);
+        const bool a_inside = (position(mesh, a) - s.position).dot(p.inward) >= 0;
+        p.candidate[1] = a_inside ? a : b;
+        p.candidate[2] = a_inside ? b : a;
+        p.traces = 3;
+        const double zero = 0;
+        if (use_feature)
+          for (int t = 0; t < 3; ++t) feature.trace(p.candidate[t], p.inward, &zero, 1, &p.trace[t]);
+      } else {
+        p.candidate[1] = walk(mesh, s.point, p.inward, step).end;
+        p.candidate[2] = walk(mesh, s.point, -p.inward, step).end;
+        p.traces = 1;
+        // The candidates lie on the bisector through the snaxel: one walk along it
+        // holds the q windows of all three.
+        const double offsets[3] = {0, step, -step};
+        if (use_feature) feature.trace(s.point, p.inward, offsets, 3, &p.trace[0]);
+      }
+    });
+
+    // 2. The planarity they need, as one parallel batch.
+    if (use_feature) {
+      w.vertices.clear();
+      for (int k = 0; k < count; ++k) {
+        const GreedyProbe& p = w.probes[k];
+        for (int t = 0; t < p.traces; ++t)
+          feature.corners(p.traces == 3 ? &p.candidate[t] : p.candidate, p.traces == 3 ? 1 : 3, p.trace[t],
+                          &w.vertices);
+      }
+      feature.planarity().prefetch_filtered(w.vertices);
     }
-    snake[i].moved = true;
-    ++moved;
+
+    // 3. Energies and decisions (reads only: thread-safe).
+    parallel_for(pool, count, [&](int k) {
+      GreedyProbe& p = w.probes[k];
+      if (p.traces == 0) return;
+      double f[3] = {0, 0, 0};
+      if (use_feature)
+        for (int j = 0; j < 3; ++j)
+          f[j] = p.traces == 3 ? feature.evaluate(p.candidate[j], p.trace[j], 0) : feature.evaluate(p.candidate[j], p.trace[0], j);
+      const double e_stay = snaxel_energy(snake, p.i, p.candidate[0], f[0], phase);
+      double e_in = snaxel_energy(snake, p.i, p.candidate[1], f[1], phase);
+      if (phase.w_d != 0)
+        e_in += phase.w_d * deflation_energy(phase.alpha, phase.beta, phase.tau, p.li, phase.gamma_sigma2);
+      const double e_out = snaxel_energy(snake, p.i, p.candidate[2], f[2], phase);
+      if (e_in < e_stay && e_in <= e_out) p.decision = 1;
+      else if (e_out < e_stay && e_out < e_in) p.decision = 2;
+    });
+
+    // 4. The moves.
+    for (int k = 0; k < count; ++k) {
+      const GreedyProbe& p = w.probes[k];
+      if (p.decision == 0) continue;
+      snake.move(p.i, p.candidate[p.decision]);
+      snake[p.i].moved = true;
+      ++moved;
+    }
   }
   return moved;
 }
 
 PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase,
-                       const ProgressCallback& progress) {
+                       const ProgressCallback& progress, WorkerPool* pool) {
   PhaseOutcome outcome;
+  GreedyWorkspace workspace;
   const double lock_distance = 2 * phase.tau * phase.l;
   std::vector<Vec3> polyline, checkpoint;
   for (int iteration = 1; iteration <= phase.max_iterations; ++iteration) {
     outcome.iterations = iteration;
-    int changes = greedy_iteration(snake, feature, phase);
+    int changes = greedy_iteration(snake, feature, phase, pool, &workspace);
 
     // Oscillation lock (Section 6.1): every lock_interval iterations, a snaxel
     // that got less than 2 tau l from where it was is frozen for the phase.

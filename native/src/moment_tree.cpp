@@ -112,54 +112,117 @@ int MomentTree::build(int begin, int end, const std::vector<unsigned>& codes) {
   return index;
 }
 
+namespace {
+
+float down(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float up(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+}  // namespace
+
+void MomentTree::set_box(Node& node, const Vec3& lo, const Vec3& hi) {
+  for (int k = 0; k < 3; ++k) {
+    node.lo[k] = down(lo[k]);
+    node.hi[k] = up(hi[k]);
+  }
+}
+
+void MomentTree::set_cone(Node& node, const Vec3& axis, double cos_spread) {
+  for (int k = 0; k < 3; ++k) node.axis[k] = static_cast<float>(axis[k]);
+  // The float axis is off by ~1e-7 rad: widen the cone by 1e-6 rad to stay conservative.
+  const double spread = cos_spread <= -1 ? M_PI : std::min(M_PI, cone_angle(cos_spread) + 1e-6);
+  node.cone_cos = spread >= M_PI ? -1.0f : down(std::cos(spread));
+  node.cone_sin = spread >= M_PI ? 0.0f : up(std::sin(spread));
+}
+
+void MomentTree::set_moments(Node& node, const PlaneMoments& m) {
+  node.weight = m.weight;
+  for (int k = 0; k < 3; ++k) node.first[k] = m.first[k];
+  const Eigen::Matrix3d& q = m.second;
+  const double entries[6] = {q(0, 0), q(1, 1), q(2, 2), q(0, 1), q(0, 2), q(1, 2)};
+  std::copy(entries, entries + 6, node.second);
+}
+
+void MomentTree::add_moments(const Node& node, PlaneMoments* m) {
+  m->weight += node.weight;
+  m->first += Vec3(node.first[0], node.first[1], node.first[2]);
+  const double* e = node.second;
+  m->second(0, 0) += e[0];
+  m->second(1, 1) += e[1];
+  m->second(2, 2) += e[2];
+  m->second(0, 1) += e[3];
+  m->second(1, 0) += e[3];
+  m->second(0, 2) += e[4];
+  m->second(2, 0) += e[4];
+  m->second(1, 2) += e[5];
+  m->second(2, 1) += e[5];
+}
+
+PlaneMoments MomentTree::moments_of(const Node& node) const {
+  PlaneMoments m;
+  add_moments(node, &m);
+  return m;
+}
+
 void MomentTree::finish_leaf(Node& node) const {
-  node.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-  node.hi = -node.lo;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   Vec3 normal_sum = Vec3::Zero();
+  PlaneMoments m;
   node.component = element_component(order_[node.begin]);
   for (int k = node.begin; k < node.end; ++k) {
     const int e = order_[k];
     if (elements_ == Elements::Faces) {
       const Vec3 a = mesh_.position(mesh_.face_vertex(e, 0)), b = mesh_.position(mesh_.face_vertex(e, 1)),
                  c = mesh_.position(mesh_.face_vertex(e, 2));
-      node.lo = node.lo.cwiseMin(a).cwiseMin(b).cwiseMin(c);
-      node.hi = node.hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
-      node.moments.add_triangle(a - origin_, b - origin_, c - origin_);
+      lo = lo.cwiseMin(a).cwiseMin(b).cwiseMin(c);
+      hi = hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
+      m.add_triangle(a - origin_, b - origin_, c - origin_, mesh_.face_area(e));
       normal_sum += mesh_.face_area(e) * mesh_.face_normal(e);
     } else {
       const Vec3& p = mesh_.position(e);
-      node.lo = node.lo.cwiseMin(p);
-      node.hi = node.hi.cwiseMax(p);
-      node.moments.add_point(p - origin_);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+      m.add_point(p - origin_);
       normal_sum += mesh_.vertex_normal(e);
     }
     if (element_component(e) != node.component) node.component = -1;
   }
+  set_box(node, lo, hi);
+  set_moments(node, m);
   const double len = normal_sum.norm();
-  node.axis = len > 0 ? Vec3(normal_sum / len) : Vec3::UnitZ();
-  node.cone_cos = len > 0 ? 1.0 : -1.0;
+  const Vec3 axis = len > 0 ? Vec3(normal_sum / len) : Vec3::UnitZ();
+  double cos_spread = len > 0 ? 1.0 : -1.0;
   if (len > 0)
-    for (int k = node.begin; k < node.end; ++k) node.cone_cos = std::min(node.cone_cos, element_normal(order_[k]).dot(node.axis));
+    for (int k = node.begin; k < node.end; ++k) cos_spread = std::min(cos_spread, element_normal(order_[k]).dot(axis));
+  set_cone(node, axis, cos_spread);
 }
 
 void MomentTree::finish_inner(Node& node, const Node& a, const Node& b) const {
-  node.lo = a.lo.cwiseMin(b.lo);
-  node.hi = a.hi.cwiseMax(b.hi);
-  node.moments = a.moments;
-  node.moments.add(b.moments);
+  for (int k = 0; k < 3; ++k) {
+    node.lo[k] = std::min(a.lo[k], b.lo[k]);
+    node.hi[k] = std::max(a.hi[k], b.hi[k]);
+  }
+  PlaneMoments m = moments_of(a);
+  add_moments(b, &m);
+  set_moments(node, m);
   node.component = a.component == b.component ? a.component : -1;
   // A cone holding both children's cones (conservative).
-  const Vec3 sum = a.moments.weight * a.axis + b.moments.weight * b.axis;
+  const Vec3 axis_a(a.axis[0], a.axis[1], a.axis[2]), axis_b(b.axis[0], b.axis[1], b.axis[2]);
+  const Vec3 sum = a.weight * axis_a + b.weight * axis_b;
   const double len = sum.norm();
   if (!(len > 0) || a.cone_cos <= -1 || b.cone_cos <= -1) {
-    node.axis = Vec3::UnitZ();
-    node.cone_cos = -1;
+    set_cone(node, Vec3::UnitZ(), -1);
     return;
   }
-  node.axis = sum / len;
-  const double spread =
-      std::max(cone_angle(a.axis.dot(node.axis)) + cone_angle(a.cone_cos), cone_angle(b.axis.dot(node.axis)) + cone_angle(b.cone_cos));
-  node.cone_cos = spread >= M_PI ? -1.0 : std::cos(spread);
+  const Vec3 axis = sum / len;
+  const double spread = std::max(cone_angle(axis_a.dot(axis)) + cone_angle(a.cone_cos),
+                                 cone_angle(axis_b.dot(axis)) + cone_angle(b.cone_cos));
+  set_cone(node, axis, spread >= M_PI ? -1.0 : std::cos(spread));
 }
 
 void MomentTree::add_cut(const Vec3& a, const Vec3& b, const Vec3& c, const Query& q, double r2,
@@ -182,38 +245,57 @@ void MomentTree::add_element(int e, const Query& q, double r2, PlaneMoments* out
 PlaneMoments MomentTree::sphere(const Query& q) const {
   PlaneMoments sum;
   if (nodes_.empty()) return sum;
-  const double r2 = q.radius * q.radius;
+  const double r2 = q.radius * q.radius, grain2 = q.grain * q.grain;
   const double facing_norm = q.facing.norm();
   const bool test_facing = facing_norm > 0 && q.min_facing > -1;
   const Vec3 facing = test_facing ? Vec3(q.facing / facing_norm) : Vec3::Zero();
   Query leaf_query = q;
   leaf_query.facing = facing;
   if (!test_facing) leaf_query.min_facing = -2;  // every normal passes
-  const double min_angle_facing = test_facing ? cone_angle(q.min_facing) : M_PI;
+  const double cx = q.center.x(), cy = q.center.y(), cz = q.center.z();
 
-  std::array<int, 128> stack;  // depth is ~log2(n / 8) + a few: far below 128
+  std::array<int, 128> stack;  // depth is ~log2(n / leaf) + a few: far below 128
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
     if (q.component >= 0 && node.component >= 0 && node.component != q.component) continue;
-    if (min_distance2(q.center, node.lo, node.hi) > r2) continue;
+    // Nearest and farthest points of the box.
+    double near2 = 0, far2 = 0, diag2 = 0;
+    const double c[3] = {cx, cy, cz};
+    for (int k = 0; k < 3; ++k) {
+      const double lo = node.lo[k], hi = node.hi[k];
+      const double below = lo - c[k], above = c[k] - hi;
+      const double gap = std::max({below, above, 0.0});
+      near2 += gap * gap;
+      const double reach = std::max(c[k] - lo, hi - c[k]);
+      far2 += reach * reach;
+      diag2 += (hi - lo) * (hi - lo);
+    }
+    if (near2 > r2) continue;
     bool all_facing = true;
     if (test_facing) {
-      // Angles between `facing` and the normals in the cone: [alpha - spread, alpha + spread].
-      const double alpha = cone_angle(node.axis.dot(facing)), spread = node.cone_cos <= -1 ? M_PI : cone_angle(node.cone_cos);
-      if (alpha - spread > min_angle_facing) continue;  // every normal faces away
-      all_facing = alpha + spread <= min_angle_facing;
+      // The cone's normals make angles alpha -+ spread with `facing` (cos alpha = d).
+      const double d = node.axis[0] * facing.x() + node.axis[1] * facing.y() + node.axis[2] * facing.z();
+      const double sin_alpha = std::sqrt(std::max(0.0, 1 - d * d));
+      const double cc = node.cone_cos, cs = node.cone_sin;
+      const double best = d >= cc ? 1.0 : d * cc + sin_alpha * cs;    // cos(max(0, alpha - spread))
+      if (best < q.min_facing) continue;                              // every normal faces away
+      const double worst = d < -cc ? -1.0 : d * cc - sin_alpha * cs;  // cos(min(pi, alpha + spread))
+      all_facing = worst >= q.min_facing;
     }
     const bool one_component = q.component < 0 || node.component == q.component;
-    if (one_component && all_facing && max_distance2(q.center, node.lo, node.hi) <= r2) {
-      sum.add(node.moments);  // wholly inside: take the node's sums
-      continue;
-    }
-    if (one_component && all_facing && (node.hi - node.lo).squaredNorm() <= q.grain * q.grain) {
-      // Small enough to count like a face: whole, if its centroid is inside.
-      if ((node.moments.first / node.moments.weight + origin_ - q.center).squaredNorm() <= r2) sum.add(node.moments);
-      continue;
+    if (one_component && all_facing) {
+      if (far2 <= r2) {
+        add_moments(node, &sum);  // wholly inside: take the node's sums
+        continue;
+      }
+      if (diag2 <= grain2) {
+        // Small enough to count like a face: whole, if its centroid is inside.
+        const Vec3 centroid = Vec3(node.first[0], node.first[1], node.first[2]) / node.weight + origin_;
+        if ((centroid - q.center).squaredNorm() <= r2) add_moments(node, &sum);
+        continue;
+      }
     }
     if (node.left < 0) {
       for (int k = node.begin; k < node.end; ++k) add_element(order_[k], leaf_query, r2, &sum);

@@ -110,7 +110,7 @@ const std::vector<Row>& rows() {
              "movement step, fraction of the local segment length (paper: 0.2)"),
       number("epsilon", &Options::epsilon, "in [0, 1)", [](double x) { return x >= 0 && x < 1; },
              "q_i is searched over (1 +- epsilon) h (paper: 0.2)"),
-      integer("q_samples", &Options::q_samples, "a whole number >= 1", [](long long n) { return n >= 1; },
+      integer("q_samples", &Options::q_samples, "a whole number from 1 to 64", [](long long n) { return n >= 1 && n <= 64; },
               "candidate q_i positions across that range"),
       boolean("exact_q", &Options::exact_q,
               "search q_i over the whole (1 +- epsilon) h stretch instead of q_samples points (not in the paper)"),

@@ -11,13 +11,29 @@ void PlaneMoments::add_point(const Vec3& x, double w) {
 }
 
 void PlaneMoments::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const double area = 0.5 * (b - a).cross(c - a).norm();
+  add_triangle(a, b, c, 0.5 * (b - a).cross(c - a).norm());
+}
+
+void PlaneMoments::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double area) {
   if (!(area > 0)) return;
   const Vec3 s = a + b + c;
   weight += area;
   first += (area / 3.0) * s;
   // Uniform density over the triangle: integral of x x^T dA = A/12 (sum_i p_i p_i^T + s s^T).
-  second.noalias() += (area / 12.0) * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  // The six distinct entries only (this is the planarity's inner loop).
+  const double k = area / 12.0;
+  auto entry = [&](int i, int j) { return k * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j]); };
+  const double xx = entry(0, 0), yy = entry(1, 1), zz = entry(2, 2), xy = entry(0, 1), xz = entry(0, 2),
+               yz = entry(1, 2);
+  second(0, 0) += xx;
+  second(1, 1) += yy;
+  second(2, 2) += zz;
+  second(0, 1) += xy;
+  second(1, 0) += xy;
+  second(0, 2) += xz;
+  second(2, 0) += xz;
+  second(1, 2) += yz;
+  second(2, 1) += yz;
 }
 
 void PlaneMoments::add(const PlaneMoments& o) {

@@ -59,7 +59,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
     throw Error("W_int must be in (0, 1] (got " + fmt(o.w_int) + "); try 0.25, then halve it if concavities are missed");
   if (!(o.tau > 0 && o.tau < 1)) throw Error("tau must be in (0, 1) (got " + fmt(o.tau) + ")");
   if (!(o.epsilon >= 0 && o.epsilon < 1)) throw Error("epsilon must be in [0, 1) (got " + fmt(o.epsilon) + ")");
-  if (o.q_samples < 1) throw Error("q_samples must be at least 1");
+  if (o.q_samples < 1 || o.q_samples > 64) throw Error("q_samples must be between 1 and 64 (the paper uses 5)");
   if (!(o.max_turn_degrees > 0 && o.max_turn_degrees <= 180))
     throw Error("max_turn_degrees must be in (0, 180]");
   if (o.lock_interval < 1) throw Error("lock_interval must be at least 1");
@@ -251,7 +251,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     const auto t_phase = Clock::now();
     if (phase == &refine) snake.subdivide(refine.l);
     snake.reset_state();
-    const PhaseOutcome outcome = run_phase(snake, feature, *phase, progress);
+    const PhaseOutcome outcome = run_phase(snake, feature, *phase, progress, planarity.pool());
     if (outcome.cancelled) {
       Result cancelled;
       cancelled.status = Status::Cancelled;

@@ -120,15 +120,16 @@ int nearest_corner(const Mesh& mesh, const SurfacePoint& p) {
 
 namespace {
 
-// The walk behind walk() and walk_sampled(); distances as a plain array so a
-// single-distance walk (the snake's inner loop) allocates nothing.
-// crossings (optional): every edge crossing at a distance in [crossings_from, total].
+// The walk behind every public walk. samples: increasing distances; out
+// (optional) receives, in walking order, the point at each sample distance (tag =
+// its index) and every edge crossing at a distance in [crossings_from,
+// crossings_to] (tag -1). The walk's length is the last sample distance. Plain
+// arrays, so a single-distance walk (the snake's inner loop) allocates nothing.
 Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
-               std::size_t n_samples, std::vector<SurfacePoint>* samples,
-               std::vector<SurfacePoint>* crossings = nullptr, double crossings_from = 0) {
+               std::size_t n_samples, std::vector<WalkPoint>* out, double crossings_from = 0,
+               double crossings_to = -1) {
   Walk result;
   result.end = start;
-  if (samples) samples->clear();
   if (n_samples == 0 || !start.valid()) return result;
   const double total = sample_distances[n_samples - 1];
 
@@ -137,9 +138,9 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
   Vec3 d = project_to_face(mesh, f, direction);
   result.direction = d;
   if (d.isZero() || !(total > 0)) {
-    if (samples)
+    if (out)
       for (std::size_t k = 0; k < n_samples; ++k)
-        if (sample_distances[k] <= 0) samples->push_back(start);
+        if (sample_distances[k] <= 0) out->push_back({start, 0.0, static_cast<int>(k)});
     return result;
   }
 
@@ -169,7 +170,7 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
       SurfacePoint s{f, b + t * db};
       s.bary = s.bary.cwiseMax(0.0);
       s.bary /= s.bary.sum();
-      if (samples) samples->push_back(s);
+      if (out) out->push_back({s, sample_distances[next_sample], static_cast<int>(next_sample)});
       ++next_sample;
     }
     if (next_sample == n_samples) {
@@ -191,7 +192,7 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
     if (!(s > 0)) break;
     e /= s;
     travelled += t_exit;
-    if (crossings && travelled >= crossings_from && travelled <= total) crossings->push_back(SurfacePoint{f, e});
+    if (out && travelled >= crossings_from && travelled <= crossings_to) out->push_back({SurfacePoint{f, e}, travelled, -1});
 
     const int g = mesh.face_neighbor(f, exit_k);
     const int ka = (exit_k + 1) % 3, kb = (exit_k + 2) % 3;
@@ -247,7 +248,17 @@ Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, do
 
 Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
                   const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
-  return walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), samples);
+  std::vector<WalkPoint> points;
+  const Walk w = walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), &points);
+  samples->clear();
+  for (const WalkPoint& p : points) samples->push_back(p.point);
+  return w;
+}
+
+Walk walk_trace(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
+                std::size_t n_samples, double crossings_from, double crossings_to, std::vector<WalkPoint>* points) {
+  points->clear();
+  return walk_impl(mesh, start, direction, sample_distances, n_samples, points, crossings_from, crossings_to);
 }
 
 namespace {
@@ -322,11 +333,11 @@ SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, con
 
 Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double from, double to,
                   std::vector<SurfacePoint>* points) {
+  std::vector<WalkPoint> traced;
+  const double ends[2] = {from, to};
+  const Walk w = walk_trace(mesh, start, direction, ends, to > from ? 2 : 1, from, to, &traced);
   points->clear();
-  std::vector<SurfacePoint> ends;
-  const double distances[2] = {from, to};
-  const Walk w = walk_impl(mesh, start, direction, distances, to > from ? 2 : 1, &ends, points, from);
-  points->insert(points->end(), ends.begin(), ends.end());
+  for (const WalkPoint& p : traced) points->push_back(p.point);
   return w;
 }
 

@@ -410,7 +410,7 @@ TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
   // The same step of height h rising over one cell (x in [0, 0.2], no vertex on the
   // wall), sampled twice: on a uniform grid, and with the relief top beyond x = 0.2
   // sampled twice as densely across. The vertex fit at the top edge follows the vertex
-  // counts; the area fit follows the surface and does not move.
+  // counts (it moves by about 0.06 h here); the area fit follows the surface.
   auto step = [](double x, double y) { return rs::Vec3(x, y, x <= 1e-9 ? 0.0 : kH); };
   Grid uniform = make_grid(60, 30, kCell, -6.0, -3.0, step);
   Grid denser = make_grid(60, 30, kCell, -6.0, -3.0, [&](double x, double y) {
@@ -432,8 +432,12 @@ TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
     EXPECT_GT(au->raw(foot), 0.1) << what;   // the signs of the step
     EXPECT_LT(au->raw(top), -0.1) << what;
     EXPECT_NEAR(au->raw(far), 0.0, 1e-9) << what;
-    EXPECT_NEAR(ad->raw(top), au->raw(top), 0.01) << what;
-    EXPECT_GT(std::abs(vd->raw(top) - vu->raw(top)), 0.03) << what;
+    // Geodesic and Euclidean sums are exact; the sphere counts tree nodes smaller than
+    // h / 2 by their centroid, so its boundary moves with the sampling by up to h / 4.
+    EXPECT_NEAR(ad->raw(top), au->raw(top), n == rs::Neighbourhood::Sphere ? 0.02 : 0.005) << what;
+    const double vertex_change = std::abs(vd->raw(top) - vu->raw(top));
+    EXPECT_GT(vertex_change, 0.03) << what;
+    EXPECT_LT(std::abs(ad->raw(top) - au->raw(top)), 0.25 * vertex_change) << what;
   }
 }
 

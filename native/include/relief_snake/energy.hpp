@@ -20,47 +20,55 @@ double normalise_alpha(double l);
 /// beta so that E_b lies in [0, 1] for segments >= 0.5 l and turns <= max_turn_degrees.
 double normalise_beta(double l, double max_turn_degrees);
 
+/// Where q is searched for up to three candidate positions of one snaxel: the points
+/// of a single straight walk from the snaxel along its inward direction. Candidate k
+/// sits at `offset[k]` along that line (0 for the snaxel, +-tau l_i for the greedy
+/// candidates, which the paper places on the same bisector), so its q window is
+/// (1 -+ epsilon) h + offset[k] along the walk.
+struct QTrace {
+  std::vector<WalkPoint> points;  ///< samples (tag = candidate * q_samples + sample) or crossings (tag -1)
+  double offset[3] = {0, 0, 0};
+  int candidates = 1;
+};
+
 /// The relief-step feature energy E_f^3 (Eqn. 8) with q_i searched over
 /// (1 +- epsilon) h along the inward direction (Section 5.3.3): at q_samples
 /// evenly spaced points (the paper's "small set of candidate positions"), or,
 /// with exact_q, over the whole stretch (the minimum of the piecewise-linear
 /// P^ along it, found at its edge crossings and ends).
+///
+/// The greedy loop uses it in three steps so that the walks and the energies can run
+/// on several threads: trace() the q line (thread-safe), gather corners() and
+/// prefetch their P^ (one parallel batch), then evaluate() (thread-safe, reads only
+/// prefetched values).
 class FeatureEnergy {
  public:
   FeatureEnergy(PlanarityField& planarity, double h, double epsilon, int q_samples, bool exact_q = false);
-  /// E_f at x, with q searched along `inward` from x; gamma applied by the caller.
-  /// Returns (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma).
+
+  /// The q line from x along `inward` for `count` (1..3) candidates at `offsets`.
+  void trace(const SurfacePoint& x, const Vec3& inward, const double* offsets, int count, QTrace* out) const;
+  /// Appends the mesh vertices whose P^ evaluate() reads for these candidate points and trace.
+  void corners(const SurfacePoint* candidates, int count, const QTrace& trace, std::vector<int>* out) const;
+  /// (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma), for candidate k of
+  /// the trace at x. 0 when the mesh ends before its window. Needs the P^ of
+  /// corners() computed; never computes any itself.
+  double evaluate(const SurfacePoint& x, const QTrace& trace, int k, SurfacePoint* q = nullptr) const;
+
+  /// One point, computing what it needs (tests and tools; not for threads).
   double unscaled(const SurfacePoint& x, const Vec3& inward);
-  /// unscaled() at count points with the same inward direction, into out[k];
-  /// the planarity they need is computed as one parallel batch.
-  void unscaled(const SurfacePoint* xs, int count, const Vec3& inward, double* out);
-  /// Computes, as one parallel batch, the planarity unscaled() will need at
-  /// and around these points (their corners and their q samples along
-  /// inward[k]). Pure speed-up: values do not depend on it.
-  void prefetch(const std::vector<SurfacePoint>& points, const std::vector<Vec3>& inward);
-  /// True if planarity had to be computed since the last mark(): the snake is
-  /// in new territory, and prefetch() pays off.
-  bool exploring() const;
-  void mark();
-  /// The q found by the last unscaled() call (for tests and drawing).
+  /// The q found by the last unscaled() call.
   const SurfacePoint& last_q() const { return last_q_; }
-  PlanarityField& planarity() { return planarity_; }
   /// Also penalise P^(x) < P^(q) (returns -(P^(x) - P^(q))^2 there). Not in the paper.
   void set_convex_barrier(bool on) { convex_barrier_ = on; }
+  PlanarityField& planarity() { return planarity_; }
 
  private:
-  /// Where q is searched for x: the sample points, or the stretch's crossings and ends.
-  void q_candidates(const SurfacePoint& x, const Vec3& inward, std::vector<SurfacePoint>* out) const;
-
   PlanarityField& planarity_;
   bool exact_q_ = false;
   double q_from_ = 0, q_to_ = 0;  // the searched stretch, (1 -+ epsilon) h
-  std::vector<double> distances_;
-  std::vector<std::vector<SurfacePoint>> samples_;  // per point of a batch
-  std::vector<int> vertices_;                       // the batch's face corners
-  SurfacePoint last_q_;
+  std::vector<double> distances_;  // the q_samples distances in it
   bool convex_barrier_ = false;
-  std::size_t mark_ = 0;  // planarity raw_count() at the last mark()
+  SurfacePoint last_q_;
 };
 
 }  // namespace relief_snake

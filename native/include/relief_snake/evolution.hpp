@@ -37,11 +37,18 @@ struct PhaseOutcome {
 double snaxel_energy(const Snake& snake, int i, const SurfacePoint& x, double feature_unscaled,
                      const PhaseSettings& phase);
 
-/// One greedy iteration; returns the number of snaxels that moved.
-int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase);
+class WorkerPool;
+struct GreedyWorkspace;  // reusable buffers of greedy_iteration()
 
-/// Runs a phase to convergence (nothing moved, housekeeping changed nothing) or the cap.
+/// One greedy iteration; returns the number of snaxels that moved. pool (optional)
+/// spreads the walks and energies over threads; the result does not depend on it.
+/// workspace (optional) keeps buffers between calls.
+int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase, WorkerPool* pool = nullptr,
+                     GreedyWorkspace* workspace = nullptr);
+
+/// Runs a phase to convergence (nothing moved, housekeeping changed nothing, or the
+/// shape stopped changing) or the cap.
 PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings& phase,
-                       const ProgressCallback& progress);
+                       const ProgressCallback& progress, WorkerPool* pool = nullptr);
 
 }  // namespace relief_snake

@@ -41,18 +41,27 @@ class MomentTree {
   std::size_t memory_bytes() const;
 
  private:
+  // The traversal fields first (one cache line), the sums after. Boxes and cones are
+  // floats rounded outwards: looser, never tighter, so the sums stay exact.
   struct Node {
-    Vec3 lo, hi;                 // bounding box of the elements (whole faces)
-    Vec3 axis;                   // normal cone: every element normal n has n . axis >= cone_cos
-    double cone_cos = -1;
+    float lo[3], hi[3];          // bounding box of the elements (whole faces)
+    float axis[3];               // normal cone: every element normal n has n . axis >= cone_cos
+    float cone_cos = -1, cone_sin = 0;
     int component = -1;          // the one component of all its elements, -1 if mixed
-    int begin = 0, end = 0;      // elements order_[begin, end)
     int left = -1, right = -1;   // children; -1 for a leaf
-    PlaneMoments moments;        // about origin_
+    int begin = 0, end = 0;      // elements order_[begin, end)
+    double weight = 0;           // moments about origin_ (PlaneMoments, the second moment's 6 entries)
+    double first[3] = {0, 0, 0};
+    double second[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy xz yz
   };
+  static void set_moments(Node& node, const PlaneMoments& m);
+  static void add_moments(const Node& node, PlaneMoments* m);
+  static void set_box(Node& node, const Vec3& lo, const Vec3& hi);
+  static void set_cone(Node& node, const Vec3& axis, double cos_spread);
   int build(int begin, int end, const std::vector<unsigned>& codes);
   void finish_leaf(Node& node) const;
   void finish_inner(Node& node, const Node& a, const Node& b) const;
+  PlaneMoments moments_of(const Node& node) const;
   void add_element(int e, const Query& q, double r2, PlaneMoments* out) const;
   void add_cut(const Vec3& a, const Vec3& b, const Vec3& c, const Query& q, double r2, PlaneMoments* out) const;
   Vec3 element_normal(int e) const;

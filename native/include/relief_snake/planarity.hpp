@@ -76,6 +76,9 @@ class PlanarityField {
   double filtered(int v);   ///< P^(v)
   /// P^ interpolated linearly inside the face of p.
   double filtered(const SurfacePoint& p);
+  /// The same from the cache only, for threads: every corner's P^ must have been
+  /// computed (prefetch_filtered()); throws Error otherwise.
+  double cached_filtered(const SurfacePoint& p) const;
 
   /// Computes and caches P at the given vertices, in parallel.
   void prefetch_raw(const std::vector<int>& vertices);
@@ -103,6 +106,10 @@ class PlanarityField {
   const std::shared_ptr<const MomentTree>& tree() const { return tree_; }
   /// The kind of MomentTree elements a fit needs.
   static MomentTree::Elements tree_elements(PlaneFit fit);
+
+  /// The threads of prefetch_*() (created on first use; null with options.threads = 1),
+  /// lent to other parallel loops of the same segmentation.
+  WorkerPool* pool();
 
   /// Number of vertices whose P (resp. P^) has been computed so far.
   std::size_t raw_count() const { return raw_count_; }

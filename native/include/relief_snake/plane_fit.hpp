@@ -21,6 +21,8 @@ struct PlaneMoments {
   void add_point(const Vec3& x, double w = 1.0);
   /// The triangle (a, b, c) with uniform density 1: weight = its area, exact moments.
   void add_triangle(const Vec3& a, const Vec3& b, const Vec3& c);
+  /// The same with its area known (Mesh::face_area()).
+  void add_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double area);
   void add(const PlaneMoments& other);
   /// The same moments about origin `o` (x -> x - o).
   PlaneMoments shifted(const Vec3& o) const;

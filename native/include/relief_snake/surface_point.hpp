@@ -45,6 +45,13 @@ struct Walk {
   int boundary_face = -1, boundary_edge = -1;  ///< the boundary edge that stopped the walk (face, opposite corner)
 };
 
+/// A point a walk passed, with its distance along the walk.
+struct WalkPoint {
+  SurfacePoint point;
+  double distance = 0;
+  int tag = -1;  ///< walk_trace(): the index of the sample distance, or -1 for an edge crossing
+};
+
 /// Walks from `start` along `direction` (projected into the start face's plane)
 /// for `distance`, crossing edges by unfolding the direction about them, so the
 /// path is a straightest line on the surface. Stops at a mesh boundary.
@@ -55,6 +62,12 @@ Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, do
 /// samples->size() is the number of sample points reached.
 Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
                   const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples);
+
+/// The same walk, for sample_distances[n_samples - 1], recording in walking order
+/// the point at each (increasing) sample distance and every edge crossing at a
+/// distance in [crossings_from, crossings_to] (none if crossings_to < crossings_from).
+Walk walk_trace(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
+                std::size_t n_samples, double crossings_from, double crossings_to, std::vector<WalkPoint>* points);
 
 /// The same walk from distance `from` to `to` (0 <= from <= to): *points gets every
 /// edge crossing in that stretch and its two ends (those reached before a boundary),
