@@ -72,8 +72,11 @@ def measure(obj, i, j):
 
 def segment_object(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_side="left",
                    max_iterations=3000, progress=None, write=True, group_name="Relief",
-                   make_curve=True):
+                   make_curve=True, options=None):
     """Segment the relief marked by `picks` (vertex indices, in order) on mesh object `obj`.
+
+    `options` (dict, optional): the engine's advanced options by name, e.g.
+    {"exact_q": True}; relief_snake_core.advanced_options() lists them.
 
     Returns the engine's result dict (status, closed, contour [(x, y, z)] in object
     space, relief_vertices, phases, ...) plus "timing": {"read", "engine", "write"}
@@ -84,7 +87,7 @@ def segment_object(obj, picks, step_height, *, w_int=0.25, open_contour=False, r
     """
     core = load_core()
     job = prepare(obj, picks, step_height, w_int=w_int, open_contour=open_contour,
-                  relief_side=relief_side, max_iterations=max_iterations)
+                  relief_side=relief_side, max_iterations=max_iterations, options=options)
     result = run(core, job, progress)
     if write:
         apply_result(obj, result, group_name=group_name, make_curve=make_curve)
@@ -92,7 +95,7 @@ def segment_object(obj, picks, step_height, *, w_int=0.25, open_contour=False, r
 
 
 def prepare(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_side="left",
-            max_iterations=3000):
+            max_iterations=3000, options=None):
     """Validate and read everything the engine needs (main thread, bpy access).
 
     Returns a job dict for run(); raises EngineError."""
@@ -113,6 +116,10 @@ def prepare(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_s
     if bad:
         raise EngineError("Pick %d is not a vertex of %r (it has %d vertices)" % (bad[0], obj.name, nv))
     kwargs["max_iterations"] = int(max_iterations)
+    for name, value in (options or {}).items():
+        if name in kwargs or name in ("progress",):
+            raise EngineError("Option %r is a main argument of segment_object(), not an advanced option" % name)
+        kwargs[name] = value
     return {"vertices": vertices, "triangles": triangles, "picks": picks,
             "step_height": float(step_height), "kwargs": kwargs, "num_vertices": nv,
             "read_seconds": time.perf_counter() - t0}
@@ -124,7 +131,7 @@ def run(core, job, progress=None):
     try:
         result = core.segment(job["vertices"], job["triangles"], job["picks"], job["step_height"],
                               progress=progress, **job["kwargs"])
-    except core.Error as exc:
+    except (core.Error, TypeError) as exc:  # TypeError: an unknown advanced option
         raise EngineError(str(exc)) from None
     result = dict(result)
     result["timing"] = {"read": job["read_seconds"], "engine": time.perf_counter() - t0, "write": 0.0}

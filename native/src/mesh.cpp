@@ -351,6 +351,7 @@ void Mesh::build_arrays() {
   // Face normals and areas; area-weighted vertex normals (sum of cross products).
   face_normals_.resize(nf);
   face_areas_.resize(nf);
+  vertex_areas_.assign(nv, 0.0);
   vertex_normals_.assign(nv, Vec3::Zero());
   for (int f = 0; f < nf; ++f) {
     const int* c = &face_vertices_[3 * f];
@@ -358,7 +359,10 @@ void Mesh::build_arrays() {
     const double norm = cross.norm();
     face_areas_[f] = 0.5 * norm;
     face_normals_[f] = norm > 0 ? Vec3(cross / norm) : Vec3(Vec3::UnitZ());
-    for (int k = 0; k < 3; ++k) vertex_normals_[c[k]] += cross;
+    for (int k = 0; k < 3; ++k) {
+      vertex_normals_[c[k]] += cross;
+      vertex_areas_[c[k]] += face_areas_[f] / 3.0;
+    }
   }
 
   // One-ring faces (CSR).

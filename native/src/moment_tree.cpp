@@ -40,6 +40,10 @@ Vec3 MomentTree::element_normal(int e) const {
   return elements_ == Elements::Faces ? mesh_.face_normal(e) : mesh_.vertex_normal(e);
 }
 
+double MomentTree::element_weight(int e) const {
+  return elements_ == Elements::WeightedVertices ? mesh_.vertex_area(e) : 1.0;
+}
+
 int MomentTree::element_component(int e) const {
   return mesh_.component(elements_ == Elements::Faces ? mesh_.face_vertex(e, 0) : e);
 }
@@ -187,7 +191,7 @@ void MomentTree::finish_leaf(Node& node) const {
       const Vec3& p = mesh_.position(e);
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
-      m.add_point(p - origin_);
+      m.add_point(p - origin_, element_weight(e));
       normal_sum += mesh_.vertex_normal(e);
     }
     if (element_component(e) != node.component) node.component = -1;
@@ -238,7 +242,7 @@ void MomentTree::add_element(int e, const Query& q, double r2, PlaneMoments* out
     add_cut(mesh_.position(mesh_.face_vertex(e, 0)), mesh_.position(mesh_.face_vertex(e, 1)),
             mesh_.position(mesh_.face_vertex(e, 2)), q, r2, out);
   } else if ((mesh_.position(e) - q.center).squaredNorm() <= r2) {
-    out->add_point(mesh_.position(e) - origin_);
+    out->add_point(mesh_.position(e) - origin_, element_weight(e));
   }
 }
 

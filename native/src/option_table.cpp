@@ -92,15 +92,21 @@ Row neighbourhood(const char* name, Neighbourhood Options::*field, const char* h
 }
 
 Row plane_fit(const char* name, PlaneFit Options::*field, const char* help) {
-  const OptionInfo info{name, OptionType::Choice, "vertices or area", help};
+  const OptionInfo info{name, OptionType::Choice, "vertices, vertex_areas or area", help};
   return {info,
           [=](Options& o, const std::string& text) {
             if (text == "vertices") o.*field = PlaneFit::Vertices;
+            else if (text == "vertex_areas") o.*field = PlaneFit::VertexAreas;
             else if (text == "area") o.*field = PlaneFit::Area;
             else bad_value(info, text);
           },
           [=](const Options& o) {
-            return std::string(o.*field == PlaneFit::Vertices ? "\"vertices\"" : "\"area\"");
+            switch (o.*field) {
+              case PlaneFit::Vertices: return std::string("\"vertices\"");
+              case PlaneFit::VertexAreas: return std::string("\"vertex_areas\"");
+              case PlaneFit::Area: return std::string("\"area\"");
+            }
+            return std::string("\"?\"");
           }};
 }
 
@@ -131,7 +137,8 @@ const std::vector<Row>& rows() {
                     "planarity neighbourhood: geodesic h-ball (paper), straight-distance h-ball connected to v, "
                     "or every part of the surface within straight distance h facing v's side (a moment tree)"),
       plane_fit("plane_fit", &Options::plane_fit,
-                "planarity plane fitted to the neighbourhood's vertices (paper) or to its surface area"),
+                "planarity plane fitted to the neighbourhood's vertices (paper), to its vertices weighted by "
+                "their areas, or to its surface area"),
       boolean("planarity_one_ring", &Options::planarity_one_ring,
               "the one-ring always counts as planarity neighbours (not in the paper)"),
       integer("threads", &Options::threads, "a whole number >= 0 (0: all cores)",

@@ -85,7 +85,12 @@ double point_source_update(const Vec3& A, const Vec3& B, const Vec3& C, double d
 }  // namespace
 
 MomentTree::Elements PlanarityField::tree_elements(PlaneFit fit) {
-  return fit == PlaneFit::Area ? MomentTree::Elements::Faces : MomentTree::Elements::Vertices;
+  switch (fit) {
+    case PlaneFit::Area: return MomentTree::Elements::Faces;
+    case PlaneFit::VertexAreas: return MomentTree::Elements::WeightedVertices;
+    case PlaneFit::Vertices: break;
+  }
+  return MomentTree::Elements::Vertices;
 }
 
 PlanarityField::PlanarityField(const Mesh& mesh, const PlanarityOptions& options,
@@ -297,12 +302,14 @@ double PlanarityField::compute_raw(int v, Scratch& s) const {
     q.grain = kSphereGrain * options_.radius;
     PlaneMoments m = tree_->sphere(q);
     const double r2 = options_.radius * options_.radius;
-    if (options_.fit == PlaneFit::Vertices) {
-      m.weight -= 1;  // v itself is in the sphere; about v its first and second moments are zero
+    if (options_.fit != PlaneFit::Area) {
+      // v itself is in the sphere; about v its first and second moments are zero.
+      m.weight -= vertex_weight(v);
       if (options_.include_one_ring)
         for (const int* it = mesh_.neighbors_begin(v); it != mesh_.neighbors_end(v); ++it)
-          if ((mesh_.position(*it) - pv).squaredNorm() > r2) m.add_point(mesh_.position(*it) - pv);
-      if (m.weight < 2.5) return one_ring_planarity(v);  // h smaller than the edges
+          if ((mesh_.position(*it) - pv).squaredNorm() > r2) m.add_point(mesh_.position(*it) - pv, vertex_weight(*it));
+      // Fewer than three neighbours (h smaller than the edges): fall back to the one-ring.
+      if (!(m.weight > 0) || (options_.fit == PlaneFit::Vertices && m.weight < 2.5)) return one_ring_planarity(v);
     } else if (options_.include_one_ring) {
       // v's own faces count whole, like the one-ring of a vertex fit.
       for (const int* f = mesh_.faces_begin(v); f != mesh_.faces_end(v); ++f) {
@@ -346,8 +353,12 @@ double PlanarityField::compute_raw(int v, Scratch& s) const {
   reset(s);
   // ball[0] is v itself; the neighbours are the rest.
   if (s.ball.size() < 4) return one_ring_planarity(v);  // h smaller than the edges
-  for (std::size_t k = 1; k < s.ball.size(); ++k) m.add_point(mesh_.position(s.ball[k]) - pv);
+  for (std::size_t k = 1; k < s.ball.size(); ++k) m.add_point(mesh_.position(s.ball[k]) - pv, vertex_weight(s.ball[k]));
   return planarity_about_vertex(m, vn);
+}
+
+double PlanarityField::vertex_weight(int v) const {
+  return options_.fit == PlaneFit::VertexAreas ? mesh_.vertex_area(v) : 1.0;
 }
 
 double PlanarityField::one_ring_planarity(int v) const {

@@ -463,6 +463,22 @@ class MeasureAndApi(AddonTestCase):
             self.assertIn(key, result["timing"])
         self.assertTrue(result["phases"])
 
+    def test_api_passes_advanced_options_to_the_engine(self):
+        api = addon().api
+        result = api.segment_object(self.obj, self.picks, self.h, write=False, options={"tau": 0.25, "threads": 1})
+        self.assertEqual(result["parameters"]["tau"], 0.25)
+        self.assertEqual(result["parameters"]["threads"], 1)
+        before = snapshot()
+        with self.assertRaises(api.EngineError) as ctx:
+            api.segment_object(self.obj, self.picks, self.h, options={"bogus": 1})
+        self.assertIn("bogus", str(ctx.exception))
+        with self.assertRaises(api.EngineError) as ctx:
+            api.segment_object(self.obj, self.picks, self.h, options={"tau": 5.0})
+        self.assertIn("tau", str(ctx.exception))
+        with self.assertRaises(api.EngineError):
+            api.segment_object(self.obj, self.picks, self.h, options={"w_int": 0.5})
+        self.assertEqual(snapshot(), before)
+
     def test_api_rejects_bad_picks(self):
         api = addon().api
         with self.assertRaises(api.EngineError) as ctx:

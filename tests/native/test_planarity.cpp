@@ -406,11 +406,12 @@ TEST(Planarity, TimingOn300kTriangles) {
   EXPECT_LE(field.filtered_count(), 2000u);
 }
 
-TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
+TEST(Planarity, AreaWeightedFitsDoNotDependOnTheSampling) {
   // The same step of height h rising over one cell (x in [0, 0.2], no vertex on the
   // wall), sampled twice: on a uniform grid, and with the relief top beyond x = 0.2
   // sampled twice as densely across. The vertex fit at the top edge follows the vertex
-  // counts (it moves by about 0.06 h here); the area fit follows the surface.
+  // counts (it moves by about 0.06 h here); the area fit follows the surface, and so,
+  // nearly, does the vertex fit weighted by vertex areas.
   auto step = [](double x, double y) { return rs::Vec3(x, y, x <= 1e-9 ? 0.0 : kH); };
   Grid uniform = make_grid(60, 30, kCell, -6.0, -3.0, step);
   Grid denser = make_grid(60, 30, kCell, -6.0, -3.0, [&](double x, double y) {
@@ -428,6 +429,7 @@ TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
     };
     auto au = field(mu, rs::PlaneFit::Area), ad = field(md, rs::PlaneFit::Area);
     auto vu = field(mu, rs::PlaneFit::Vertices), vd = field(md, rs::PlaneFit::Vertices);
+    auto wu = field(mu, rs::PlaneFit::VertexAreas), wd = field(md, rs::PlaneFit::VertexAreas);
     const std::string what = "neighbourhood " + std::to_string(static_cast<int>(n));
     EXPECT_GT(au->raw(foot), 0.1) << what;   // the signs of the step
     EXPECT_LT(au->raw(top), -0.1) << what;
@@ -436,6 +438,11 @@ TEST(Planarity, AreaFitDoesNotDependOnTheSampling) {
     // h / 2 by their centroid, so its boundary moves with the sampling by up to h / 4.
     EXPECT_NEAR(ad->raw(top), au->raw(top), n == rs::Neighbourhood::Sphere ? 0.02 : 0.005) << what;
     const double vertex_change = std::abs(vd->raw(top) - vu->raw(top));
+    // Weighting the vertices by their areas takes most of the sampling out of the vertex fit.
+    EXPECT_GT(wu->raw(foot), 0.1) << what;
+    EXPECT_LT(wu->raw(top), -0.1) << what;
+    EXPECT_NEAR(wu->raw(far), 0.0, 1e-9) << what;
+    EXPECT_LT(std::abs(wd->raw(top) - wu->raw(top)), 0.25 * vertex_change) << what;
     EXPECT_GT(vertex_change, 0.03) << what;
     EXPECT_LT(std::abs(ad->raw(top) - au->raw(top)), 0.25 * vertex_change) << what;
   }

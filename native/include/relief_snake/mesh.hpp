@@ -63,6 +63,8 @@ class Mesh {
   int face_neighbor(int f, int k) const { return face_neighbors_[3 * f + k]; }
   const Vec3& face_normal(int f) const { return face_normals_[f]; }
   double face_area(int f) const { return face_areas_[f]; }
+  /// A third of the area of the faces around v (its share of the surface).
+  double vertex_area(int v) const { return vertex_areas_[v]; }
   /// Area-weighted average of the incident face normals, unit length.
   const Vec3& vertex_normal(int v) const { return vertex_normals_[v]; }
 
@@ -96,7 +98,7 @@ class Mesh {
   TriMesh om_;
   MeshReport report_;
   std::vector<Vec3> positions_, face_normals_, vertex_normals_;
-  std::vector<double> face_areas_;
+  std::vector<double> face_areas_, vertex_areas_;
   std::vector<int> face_vertices_, face_neighbors_;
   std::vector<int> ring_vertices_, ring_faces_;
   std::vector<std::size_t> ring_vertex_offsets_, ring_face_offsets_;

@@ -14,7 +14,9 @@ namespace relief_snake {
 
 class MomentTree {
  public:
-  enum class Elements { Faces, Vertices };
+  /// Faces (area moments), vertices (unit points) or vertices weighted by their area
+  /// (a third of the area of their faces).
+  enum class Elements { Faces, Vertices, WeightedVertices };
 
   /// Builds the hierarchy over every face (or vertex) of the mesh: O(n log n).
   MomentTree(const Mesh& mesh, Elements elements);
@@ -66,6 +68,7 @@ class MomentTree {
   void add_cut(const Vec3& a, const Vec3& b, const Vec3& c, const Query& q, double r2, PlaneMoments* out) const;
   Vec3 element_normal(int e) const;
   int element_component(int e) const;
+  double element_weight(int e) const;  // vertices: 1 or their area
 
   const Mesh& mesh_;
   Elements elements_;

@@ -25,6 +25,9 @@ enum class Neighbourhood {
 /// What the plane is fitted to.
 enum class PlaneFit {
   Vertices,  ///< the neighbouring vertices, one unit weight each (the paper; v itself excluded)
+  /// The neighbouring vertices, each weighted by its area (a third of its faces'): the
+  /// vertex fit without the bias towards densely sampled parts (not in the paper).
+  VertexAreas,
   /// The neighbourhood's surface, weighted by area: faces whose corners are all in the
   /// neighbourhood (Geodesic, Euclidean) or the surface inside the sphere (Sphere). Does not
   /// depend on how densely each part was sampled, e.g. a step wall with no vertices on it
@@ -128,6 +131,8 @@ class PlanarityField {
   double compute_raw(int v, Scratch& scratch) const;
   /// P(v) against the plane of its one-ring (h smaller than the edges).
   double one_ring_planarity(int v) const;
+  /// A vertex's weight in a vertex fit: 1, or its area (PlaneFit::VertexAreas).
+  double vertex_weight(int v) const;
   double compute_filtered(int v);
   void check_vertex(int v) const;
   /// Fast marching from v up to radius(); fills scratch.ball.
