@@ -307,6 +307,15 @@ int Snake::remove_loops() {
     // that crossings seen along a tilted normal are not missed, sorted along
     // the snake's longest axis; only boxes overlapping on all three axes are
     // tested. O(n log n) per pass, no allocation after the first.
+    // A crossing needs a segment that changed since the last check (every
+    // change to the snake marks the snaxels it touches as moved).
+    dirty.resize(segments);
+    bool any_dirty = false;
+    for (int i = 0; i < segments; ++i) {
+      dirty[i] = snaxels_[i].moved || snaxels_[next(i)].moved;
+      any_dirty = any_dirty || dirty[i];
+    }
+    if (!any_dirty) break;
     double longest = 0;
     Eigen::AlignedBox3d extent;
     boxes.resize(segments);
@@ -317,15 +326,6 @@ int Snake::remove_loops() {
       extent.extend(boxes[i]);
     }
     if (!(longest > 0)) break;
-    // A crossing needs a segment that changed since the last check (every
-    // change to the snake marks the snaxels it touches as moved).
-    dirty.resize(segments);
-    bool any_dirty = false;
-    for (int i = 0; i < segments; ++i) {
-      dirty[i] = snaxels_[i].moved || snaxels_[next(i)].moved;
-      any_dirty = any_dirty || dirty[i];
-    }
-    if (!any_dirty) break;
     const Vec3 margin = Vec3::Constant(0.5 * longest);
     for (Eigen::AlignedBox3d& box : boxes) box = Eigen::AlignedBox3d(box.min() - margin, box.max() + margin);
     int axis = 0;

@@ -193,7 +193,7 @@ def test_help_lists_the_advanced_options(cli):
         ("remove_loops=maybe", ["remove_loops", "0, 1, true or false", "'maybe'"]),
         ("convex_barrier=", ["convex_barrier"]),
         ("neighbourhood=manhattan", ["neighbourhood", "geodesic, euclidean or sphere", "'manhattan'"]),
-        ("plane_fit=faces", ["plane_fit", "vertices or area", "'faces'"]),
+        ("plane_fit=faces", ["plane_fit", "vertices, vertex_areas or area", "'faces'"]),
         ("planarity_one_ring=2", ["planarity_one_ring"]),
         ("threads=-1", ["threads", ">= 0"]),
     ],
@@ -228,7 +228,7 @@ def test_advanced_options_reach_the_engine_and_the_report(cli, build_dir, tmp_pa
     assert params["feature_contrast"] == 0.25
     assert params["scale_feature_with_spacing"] is True and params["convex_barrier"] is False
     assert params["remove_loops"] is True
-    assert params["neighbourhood"] == "geodesic" and params["planarity_one_ring"] is True and params["threads"] == 0
+    assert params["neighbourhood"] == "sphere" and params["plane_fit"] == "vertex_areas" and params["planarity_one_ring"] is True and params["threads"] == 0
 
     # Set: repeated --option, both spellings, the last one of a name wins. (The iteration cap only
     # bounds the run time; whether these values segment well is the benchmark's business.)

@@ -323,11 +323,13 @@ def test_bad_advanced_options(scan, kwargs, error, words):
 def test_advanced_options_reach_the_engine(scan, disk_result):
     V, F, picks, _, h, _ = scan
     r = core.segment(V, F, picks, h, progress=deadline(), tau=0.25, q_samples=7, exact_q=True,
-                     neighbourhood="sphere", plane_fit="area", threads=1)
+                     neighbourhood="geodesic", plane_fit="area", threads=1)
     p = r["parameters"]
     assert p["tau"] == 0.25 and p["q_samples"] == 7 and p["exact_q"] is True and p["threads"] == 1
-    assert p["neighbourhood"] == "sphere" and p["plane_fit"] == "area"
-    assert disk_result["parameters"]["neighbourhood"] == "geodesic"  # the defaults, reported
+    assert p["neighbourhood"] == "geodesic" and p["plane_fit"] == "area"
+    defaults = {o["name"]: o["default"] for o in core.advanced_options()}
+    for name, value in defaults.items():  # the defaults, reported
+        assert disk_result["parameters"][name] == value, name
     assert r["relief_vertices"] != disk_result["relief_vertices"] or r["contour"] != disk_result["contour"]
 
 
