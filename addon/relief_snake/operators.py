@@ -121,7 +121,8 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         def progress(phase, iteration, snaxels, contour):
             # Worker thread: no bpy here, only hand the latest state to the timer.
             shared["phase"], shared["iteration"], shared["snaxels"] = phase, iteration, snaxels
-            shared["contour"] = contour
+            if contour is not None:  # the engine sends it at most every 0.1 s
+                shared["contour"] = contour
             return not shared["cancel"]
 
         def work():

@@ -34,6 +34,9 @@ namespace py = pybind11;
 namespace relief_snake {
 namespace {
 
+/// How often the progress callback receives the contour (seconds); None in between.
+constexpr double kContourSeconds = 0.1;
+
 /// Thrown (C++ side) when the progress callback cancels; becomes relief_snake_core.Cancelled.
 struct CancelledError : std::exception {
   const char* what() const noexcept override { return "segmentation cancelled by the progress callback"; }
@@ -357,13 +360,22 @@ py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lo
   std::exception_ptr callback_error;
   ProgressCallback callback;
   if (!progress.is_none()) {
-    callback = [&progress, &callback_error](const Progress& p) -> bool {
+    // The contour goes to Python (a list of tuples: ~1 ms for a few thousand snaxels) at
+    // most every kContourSeconds and at every phase's first call; other calls get None.
+    auto last_contour = std::make_shared<std::pair<std::string, std::chrono::steady_clock::time_point>>();
+    callback = [&progress, &callback_error, last_contour](const Progress& p) -> bool {
       py::gil_scoped_acquire acquire;
       if (callback_error) return false;
       try {
-        py::list contour;
-        if (p.contour)
-          for (const Vec3& v : *p.contour) contour.append(point(v));
+        const auto now = std::chrono::steady_clock::now();
+        py::object contour = py::none();
+        if (last_contour->first != p.phase ||
+            std::chrono::duration<double>(now - last_contour->second).count() >= kContourSeconds) {
+          py::list points;
+          for (const Vec3& v : p.contour()) points.append(point(v));
+          contour = points;
+          *last_contour = {p.phase ? p.phase : "", now};
+        }
         py::object answer = progress(py::str(p.phase ? p.phase : ""), p.iteration, p.snaxels, contour);
         if (answer.is_none()) return true;
         const int truth = PyObject_IsTrue(answer.ptr());
@@ -449,8 +461,9 @@ PYBIND11_MODULE(relief_snake_core, m) {
       "        max_iterations=3000, progress=None, **advanced) -> dict\n\n"
       "vertices: n by 3 (or flat 3n) floats; triangles: m by 3 (or flat 3m) integer vertex indices;\n"
       "picks: vertex indices around the relief, in order (>= 3 closed, >= 2 open); step_height: h > 0.\n"
-      "progress(phase: str, iteration: int, snaxels: int, contour: list of (x, y, z)) -> bool|None is called\n"
-      "every iteration; returning False raises Cancelled. Returns a dict with status, closed, contour,\n"
+      "progress(phase: str, iteration: int, snaxels: int, contour: list of (x, y, z) or None) -> bool|None is\n"
+      "called every iteration (contour: at each phase's first call and then at most every 0.1 s, None in\n"
+      "between); returning False raises Cancelled. Returns a dict with status, closed, contour,\n"
       "relief_vertices, phases, parameters, planarity_vertices, notes, mesh_report and seconds.\n"
       "**advanced: the engine's advanced options by name (e.g. tau=0.2, exact_q=True); advanced_options()\n"
       "lists them with their types, ranges and defaults. An unknown name raises TypeError.";

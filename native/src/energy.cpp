@@ -102,13 +102,15 @@ double FeatureEnergy::evaluate(const SurfacePoint& x, const QTrace& trace, int k
     const bool mine = exact_q_ ? (p.distance >= lo && p.distance <= hi) : (p.tag >= 0 && p.tag / samples == k);
     if (!mine) continue;
     const double value = planarity_.cached_filtered(p.point);
+    if (std::isnan(value)) return value;  // not computed yet
     if (value < q_value) {
       q_value = value;
       if (q) *q = p.point;
     }
   }
   if (q_value == std::numeric_limits<double>::infinity()) return 0;  // the mesh ends before the window
-  const double d = planarity_.cached_filtered(x) - q_value;
+  const double d = planarity_.cached_filtered(x) - q_value;  // NaN if P^(x) is missing
+  if (std::isnan(d)) return d;
   if (d > 0) return d * d;
   // Optional barrier: a snaxel on a convex crease looking inwards (P^(x) < P^(q))
   // is penalised instead of ignored, so it cannot slip past the step's top edge.

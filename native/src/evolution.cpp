@@ -1,5 +1,6 @@
 #include "relief_snake/evolution.hpp"
 
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -34,6 +35,7 @@ struct GreedyProbe {
   QTrace trace[3];            // interior snaxels: trace[0] for all three; open ends: one each
   int traces = 0;             // 0: nothing to evaluate (no inward direction)
   int decision = 0;           // 0 stay, 1 inside, 2 outside
+  bool missing = false;       // its energies need planarity not computed yet
 };
 
 namespace {
@@ -57,6 +59,7 @@ struct GreedyWorkspace {
   std::vector<int> vertices;
   std::vector<char> moved_before;
   std::vector<int> indices;
+  std::vector<int> retry;
 };
 
 
@@ -136,26 +139,22 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
       }
     });
 
-    // 2. The planarity they need, as one parallel batch.
-    if (use_feature) {
-      w.vertices.clear();
-      for (int k = 0; k < count; ++k) {
-        const GreedyProbe& p = w.probes[k];
-        for (int t = 0; t < p.traces; ++t)
-          feature.corners(p.traces == 3 ? &p.candidate[t] : p.candidate, p.traces == 3 ? 1 : 3, p.trace[t],
-                          &w.vertices);
-      }
-      feature.planarity().prefetch_filtered(w.vertices);
-    }
-
-    // 3. Energies and decisions (reads only: thread-safe).
-    parallel_for(pool, count, [&](int k) {
+    // 2. Energies and decisions (reads cached planarity only: thread-safe). A probe
+    // that needs planarity not computed yet gets NaN energies and is done again below.
+    auto decide = [&](int k) {
       GreedyProbe& p = w.probes[k];
+      p.missing = false;
       if (p.traces == 0) return;
       double f[3] = {0, 0, 0};
       if (use_feature)
-        for (int j = 0; j < 3; ++j)
-          f[j] = p.traces == 3 ? feature.evaluate(p.candidate[j], p.trace[j], 0) : feature.evaluate(p.candidate[j], p.trace[0], j);
+        for (int j = 0; j < 3; ++j) {
+          f[j] = p.traces == 3 ? feature.evaluate(p.candidate[j], p.trace[j], 0)
+                               : feature.evaluate(p.candidate[j], p.trace[0], j);
+          if (std::isnan(f[j])) {
+            p.missing = true;
+            return;
+          }
+        }
       const double e_stay = snaxel_energy(snake, p.i, p.candidate[0], f[0], phase);
       double e_in = snaxel_energy(snake, p.i, p.candidate[1], f[1], phase);
       if (phase.w_d != 0)
@@ -163,7 +162,26 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
       const double e_out = snaxel_energy(snake, p.i, p.candidate[2], f[2], phase);
       if (e_in < e_stay && e_in <= e_out) p.decision = 1;
       else if (e_out < e_stay && e_out < e_in) p.decision = 2;
-    });
+    };
+    parallel_for(pool, count, decide);
+
+    // 3. The missing planarity, as one parallel batch, then those probes again.
+    if (use_feature) {
+      w.vertices.clear();
+      w.retry.clear();
+      for (int k = 0; k < count; ++k) {
+        const GreedyProbe& p = w.probes[k];
+        if (!p.missing) continue;
+        w.retry.push_back(k);
+        for (int t = 0; t < p.traces; ++t)
+          feature.corners(p.traces == 3 ? &p.candidate[t] : p.candidate, p.traces == 3 ? 1 : 3, p.trace[t],
+                          &w.vertices);
+      }
+      if (!w.retry.empty()) {
+        feature.planarity().prefetch_filtered(w.vertices);
+        parallel_for(pool, static_cast<int>(w.retry.size()), [&](int r) { decide(w.retry[r]); });
+      }
+    }
 
     // 4. The moves.
     for (int k = 0; k < count; ++k) {
@@ -182,7 +200,7 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
   PhaseOutcome outcome;
   GreedyWorkspace workspace;
   const double lock_distance = 2 * phase.tau * phase.l;
-  std::vector<Vec3> polyline, checkpoint;
+  std::vector<Vec3> checkpoint;
   for (int iteration = 1; iteration <= phase.max_iterations; ++iteration) {
     outcome.iterations = iteration;
     int changes = greedy_iteration(snake, feature, phase, pool, &workspace);
@@ -205,12 +223,11 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
       return outcome;
     }
     if (progress) {
-      polyline = snake.polyline();
       Progress p;
       p.phase = phase.name;
       p.iteration = iteration;
       p.snaxels = snake.size();
-      p.contour = &polyline;
+      p.contour = [&snake] { return snake.polyline(); };
       if (!progress(p)) {
         outcome.cancelled = true;
         return outcome;

@@ -143,17 +143,24 @@ Snake::Snake(const Mesh& mesh, const std::vector<SurfacePoint>& points, bool clo
   for (const SurfacePoint& p : points) snaxels_.push_back(make(p));
 }
 
-Snaxel Snake::make(const SurfacePoint& p) const {
+Snaxel Snake::make(const SurfacePoint& p) {
   Snaxel s;
   s.point = p;
   s.position = relief_snake::position(mesh_, p);
   s.anchor = s.position;
+  s.stamp = ++version_;
   return s;
+}
+
+void Snake::touch(int i) {
+  snaxels_[i].stamp = ++version_;
+  snaxels_[i].moved = true;
 }
 
 void Snake::move(int i, const SurfacePoint& p) {
   snaxels_[i].point = p;
   snaxels_[i].position = relief_snake::position(mesh_, p);
+  snaxels_[i].stamp = ++version_;
 }
 
 Vec3 Snake::inward(int i) const {
@@ -207,17 +214,35 @@ double Snake::length() const {
   return total;
 }
 
+double Snake::turn_cos(int i) const {
+  const int ip = prev(i), in = next(i);
+  if (ip < 0 || in < 0) return 1;
+  const Vec3 a = snaxels_[i].position - snaxels_[ip].position;
+  const Vec3 b = snaxels_[in].position - snaxels_[i].position;
+  const double na = a.norm(), nb = b.norm();
+  if (!(na > 0) || !(nb > 0)) return 1;
+  return std::clamp(a.dot(b) / (na * nb), -1.0, 1.0);
+}
+
 int Snake::remove_sharp_turns(double max_degrees) {
+  // A turn depends on a snaxel and its two neighbours: unchanged triples passed last time.
+  const std::uint64_t since = turns_checked_;
+  turns_checked_ = version_;
+  const double cos_max = std::cos(max_degrees / kDegrees);  // turning more than max_degrees <=> cos below
   int removed = 0;
   for (int i = 0; i < size() && size() > 3;) {
-    if (!is_end(i) && turn_degrees(i) > max_degrees) {
+    const int ip = prev(i), in = next(i);
+    const bool changed = changed_since(i, since) || (ip >= 0 && changed_since(ip, since)) ||
+                         (in >= 0 && changed_since(in, since));
+    if (changed && !is_end(i) && turn_cos(i) < cos_max) {
       snaxels_.erase(snaxels_.begin() + i);
       ++removed;
-      // The neighbours' turning angles changed: re-check from the previous one.
+      // The neighbours' turning angles changed: mark them, re-check from the previous one.
+      const int before = i > 0 ? i - 1 : (closed_ ? size() - 1 : -1);
+      if (before >= 0) touch(before);
+      if (i < size()) touch(i);
+      else if (closed_) touch(0);
       if (i > 0) --i;
-      const int ip = prev(i);
-      if (ip >= 0) snaxels_[ip].moved = true;
-      if (i < size()) snaxels_[i].moved = true;
     } else {
       ++i;
     }
@@ -225,7 +250,7 @@ int Snake::remove_sharp_turns(double max_degrees) {
   return removed;
 }
 
-int Snake::append_between(int i, int j, int pieces, std::vector<Snaxel>* out) const {
+int Snake::append_between(int i, int j, int pieces, std::vector<Snaxel>* out) {
   if (pieces < 2) return 0;
   std::vector<double> fractions;
   for (int k = 1; k < pieces; ++k) fractions.push_back(static_cast<double>(k) / pieces);
@@ -236,32 +261,46 @@ int Snake::append_between(int i, int j, int pieces, std::vector<Snaxel>* out) co
 
 int Snake::resample(double l) {
   const double lmin = 0.5 * l, lmax = 1.5 * l;
+  // A segment whose ends did not change since the last call (with this l) was in range.
+  const std::uint64_t since = l == spacing_l_ ? spacing_checked_ : 0;
+  spacing_checked_ = version_;
+  spacing_l_ = l;
+  auto dirty = [&](int i, int j) { return changed_since(i, since) || changed_since(j, since); };
   int changes = 0;
-  std::vector<Snaxel> out;
-  out.reserve(snaxels_.size() + 16);
-  // Split pass: insert midpoints into long segments (as many as needed).
+  // Split pass: insert points into long segments (as many as needed); the snake is
+  // rebuilt only when some segment is too long.
   const int n = size();
-  for (int i = 0; i < n; ++i) {
-    out.push_back(snaxels_[i]);
+  int first_long = -1;
+  for (int i = 0; i < n && first_long < 0; ++i) {
     const int j = next(i);
-    if (j < 0) continue;
-    const double d = (snaxels_[j].position - snaxels_[i].position).norm();
-    if (d > lmax) changes += append_between(i, j, static_cast<int>(std::ceil(d / l)), &out);
+    if (j >= 0 && dirty(i, j) && (snaxels_[j].position - snaxels_[i].position).norm() > lmax) first_long = i;
   }
-  snaxels_.swap(out);
+  if (first_long >= 0) {
+    std::vector<Snaxel> out;
+    out.reserve(snaxels_.size() + 16);
+    for (int i = 0; i < n; ++i) {
+      out.push_back(snaxels_[i]);
+      const int j = next(i);
+      if (j < 0 || i < first_long || !dirty(i, j)) continue;
+      const double d = (snaxels_[j].position - snaxels_[i].position).norm();
+      if (d > lmax) changes += append_between(i, j, static_cast<int>(std::ceil(d / l)), &out);
+    }
+    snaxels_.swap(out);
+  }
   // Merge pass: replace a too-short pair by its midpoint (open ends stay put).
   for (int i = 0; i < size() && size() > 3;) {
     const int j = next(i);
     if (j < 0) break;
-    const double d = (snaxels_[j].position - snaxels_[i].position).norm();
-    if (d >= lmin) {
+    if (!dirty(i, j) || (snaxels_[j].position - snaxels_[i].position).norm() >= lmin) {
       ++i;
       continue;
     }
     if (is_end(i)) {
       snaxels_.erase(snaxels_.begin() + j);
+      touch(i);
     } else if (is_end(j)) {
       snaxels_.erase(snaxels_.begin() + i);
+      touch(i < size() ? i : i - 1);
     } else {
       Snaxel merged = make(surface_midpoint(mesh_, snaxels_[i].point, snaxels_[j].point, nearest_resampling_));
       merged.moved = true;
@@ -295,61 +334,90 @@ bool segments_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
 }  // namespace
 
 int Snake::remove_loops() {
+  // Untouched segments did not cross at the last call and have not moved since: only
+  // pairs with a changed segment can cross now.
+  const std::uint64_t since = loops_checked_;
+  loops_checked_ = version_;
   int removed = 0;
-  std::vector<int> order;
-  std::vector<Eigen::AlignedBox3d> boxes;
-  std::vector<char> dirty;
+  std::vector<int> dirty;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
     const int segments = closed_ ? n : n - 1;
     if (segments < 4) break;
-    // Sweep and prune: segment boxes, grown by half the longest segment so
-    // that crossings seen along a tilted normal are not missed, sorted along
-    // the snake's longest axis; only boxes overlapping on all three axes are
-    // tested. O(n log n) per pass, no allocation after the first.
-    // A crossing needs a segment that changed since the last check (every
-    // change to the snake marks the snaxels it touches as moved).
-    dirty.resize(segments);
-    bool any_dirty = false;
-    for (int i = 0; i < segments; ++i) {
-      dirty[i] = snaxels_[i].moved || snaxels_[next(i)].moved;
-      any_dirty = any_dirty || dirty[i];
-    }
-    if (!any_dirty) break;
+    dirty.clear();
+    for (int i = 0; i < segments; ++i)
+      if (changed_since(i, since) || changed_since(next(i), since)) dirty.push_back(i);
+    if (dirty.empty()) break;
     double longest = 0;
-    Eigen::AlignedBox3d extent;
-    boxes.resize(segments);
-    for (int i = 0; i < segments; ++i) {
-      const Vec3 &p0 = snaxels_[i].position, &p1 = snaxels_[next(i)].position;
-      longest = std::max(longest, (p1 - p0).norm());
-      boxes[i] = Eigen::AlignedBox3d(p0.cwiseMin(p1), p0.cwiseMax(p1));
-      extent.extend(boxes[i]);
-    }
+    for (int i = 0; i < segments; ++i)
+      longest = std::max(longest, (snaxels_[next(i)].position - snaxels_[i].position).norm());
     if (!(longest > 0)) break;
-    const Vec3 margin = Vec3::Constant(0.5 * longest);
-    for (Eigen::AlignedBox3d& box : boxes) box = Eigen::AlignedBox3d(box.min() - margin, box.max() + margin);
-    int axis = 0;
-    extent.sizes().maxCoeff(&axis);
-    order.resize(segments);
-    for (int i = 0; i < segments; ++i) order[i] = i;
-    std::sort(order.begin(), order.end(),
-              [&](int a, int b) { return boxes[a].min()(axis) < boxes[b].min()(axis); });
+    // Segment boxes, grown by half the longest segment so that crossings seen along a
+    // tilted normal are not missed. Two boxes that meet have midpoints at most twice
+    // the longest segment apart: in a hash grid of that cell size, each segment goes
+    // into its midpoint's cell and a changed one looks at the 27 cells around its own.
+    const double margin = 0.5 * longest, cell = 2 * longest;
+    auto box = [&](int i, Vec3* lo, Vec3* hi) {
+      const Vec3 &p0 = snaxels_[i].position, &p1 = snaxels_[next(i)].position;
+      *lo = p0.cwiseMin(p1) - Vec3::Constant(margin);
+      *hi = p0.cwiseMax(p1) + Vec3::Constant(margin);
+    };
+    auto cell_of = [&](int i) {
+      const Vec3 mid = 0.5 * (snaxels_[i].position + snaxels_[next(i)].position);
+      return Eigen::Array3i((mid / cell).array().floor().cast<int>());
+    };
+    auto key_of = [](const Eigen::Array3i& c) {
+      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x())) << 42) ^
+             (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y())) << 21) ^
+             static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()));
+    };
+    std::uint32_t buckets = 1;
+    while (buckets < 2u * static_cast<std::uint32_t>(segments)) buckets <<= 1;
+    auto bucket_of = [&](std::uint64_t key) {
+      return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & (buckets - 1);
+    };
+    // Counting sort of (cell, segment) entries by bucket.
+    grid_keys_.resize(segments);
+    grid_start_.assign(buckets + 1, 0);
+    for (int i = 0; i < segments; ++i) {
+      grid_keys_[i] = key_of(cell_of(i));
+      ++grid_start_[bucket_of(grid_keys_[i]) + 1];
+    }
+    for (std::uint32_t k = 0; k < buckets; ++k) grid_start_[k + 1] += grid_start_[k];
+    grid_entries_.resize(segments);
+    {
+      std::vector<std::uint32_t> fill(grid_start_.begin(), grid_start_.end() - 1);
+      for (int i = 0; i < segments; ++i) grid_entries_[fill[bucket_of(grid_keys_[i])]++] = {grid_keys_[i], i};
+    }
+    auto for_near = [&](int d, const auto& visit) {
+      const Eigen::Array3i c = cell_of(d);
+      for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+          for (int z = -1; z <= 1; ++z) {
+            const std::uint64_t key = key_of(c + Eigen::Array3i(x, y, z));
+            const std::uint32_t bucket = bucket_of(key);
+            for (std::uint32_t e = grid_start_[bucket]; e < grid_start_[bucket + 1]; ++e)
+              if (grid_entries_[e].first == key) visit(grid_entries_[e].second);
+          }
+    };
     // The crossing with the smallest first segment (then second), as a scan along the snake would find.
     int cut_a = -1, cut_b = -1;
-    for (int k = 0; k < segments; ++k) {
-      const int i = order[k];
-      for (int m = k + 1; m < segments && boxes[order[m]].min()(axis) <= boxes[i].max()(axis); ++m) {
-        const int a = std::min(i, order[m]), b = std::max(i, order[m]);
-        if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) continue;  // neighbours share a snaxel
-        if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) continue;
-        if (!dirty[a] && !dirty[b]) continue;
-        if (!boxes[a].intersects(boxes[b])) continue;
+    for (int d : dirty) {
+      Vec3 dlo, dhi;
+      box(d, &dlo, &dhi);
+      for_near(d, [&](int other) {
+        const int a = std::min(d, other), b = std::max(d, other);
+        if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) return;  // neighbours share a snaxel
+        if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) return;
+        Vec3 olo, ohi;
+        box(other, &olo, &ohi);
+        if ((olo.array() > dhi.array()).any() || (dlo.array() > ohi.array()).any()) return;
         if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
                            snaxels_[next(b)].position, normal(mesh_, snaxels_[a].point))) {
           cut_a = a;
           cut_b = b;
         }
-      }
+      });
     }
     if (cut_a < 0) break;
     // Segments a and b cross: the loop is snaxels a+1 .. b (inner arc) or the
@@ -374,6 +442,10 @@ int Snake::remove_loops() {
     }
     removed += n - static_cast<int>(kept.size());
     snaxels_.swap(kept);
+    // The new segment (across the cut) changed; the greedy step looks at every snaxel again.
+    const int joint = keep_outer ? cut_a : static_cast<int>(snaxels_.size()) - 1;
+    touch(joint);
+    if (next(joint) >= 0) touch(next(joint));
     for (Snaxel& s : snaxels_) s.moved = true;
   }
   return removed;

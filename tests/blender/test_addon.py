@@ -366,7 +366,7 @@ class ErrorPaths(AddonTestCase):
         calls = []
 
         def progress(phase, iteration, snaxels, contour):
-            calls.append((phase, iteration, snaxels, len(contour)))
+            calls.append((phase, iteration, snaxels, None if contour is None else len(contour)))
             return len(calls) < 3
 
         before = snapshot()

@@ -50,8 +50,8 @@ class FeatureEnergy {
   /// Appends the mesh vertices whose P^ evaluate() reads for these candidate points and trace.
   void corners(const SurfacePoint* candidates, int count, const QTrace& trace, std::vector<int>* out) const;
   /// (P^(x) - P^(q))^2 if P^(x) > P^(q), else 0 (i.e. -E_f / gamma), for candidate k of
-  /// the trace at x. 0 when the mesh ends before its window. Needs the P^ of
-  /// corners() computed; never computes any itself.
+  /// the trace at x. 0 when the mesh ends before its window. Reads cached P^ only and
+  /// never computes any: NaN when some of what it needs (corners()) is missing.
   double evaluate(const SurfacePoint& x, const QTrace& trace, int k, SurfacePoint* q = nullptr) const;
 
   /// One point, computing what it needs (tests and tools; not for threads).

@@ -79,8 +79,8 @@ class PlanarityField {
   double filtered(int v);   ///< P^(v)
   /// P^ interpolated linearly inside the face of p.
   double filtered(const SurfacePoint& p);
-  /// The same from the cache only, for threads: every corner's P^ must have been
-  /// computed (prefetch_filtered()); throws Error otherwise.
+  /// The same from the cache only, for threads: NaN if a corner's P^ has not been
+  /// computed yet (prefetch_filtered() computes it).
   double cached_filtered(const SurfacePoint& p) const;
 
   /// Computes and caches P at the given vertices, in parallel.

@@ -90,12 +90,14 @@ struct Result {
   std::vector<std::string> notes;        ///< non-fatal remarks (e.g. open-contour ends extended to the boundary)
 };
 
-/// What the progress callback sees. `contour` is valid only during the call.
+/// What the progress callback sees (valid only during the call).
 struct Progress {
   const char* phase = "";
   int iteration = 0;
   int snaxels = 0;
-  const std::vector<Vec3>* contour = nullptr;
+  /// The snake's current 3D polyline, built on each call (O(snaxels)): call it only
+  /// when it is drawn.
+  std::function<std::vector<Vec3>()> contour;
 };
 /// Called once per iteration; return false to cancel.
 using ProgressCallback = std::function<bool(const Progress&)>;

@@ -3,6 +3,7 @@
 // housekeeping (Sections 6 and 7.2.2): split/merge to keep spacing in
 // [0.5 l, 1.5 l], removal of sharp turns, and sliding of open ends along the
 // mesh boundary.
+#include <cstdint>
 #include <vector>
 
 #include "relief_snake/mesh.hpp"
@@ -17,6 +18,9 @@ struct Snaxel {
   bool locked = false;      ///< oscillation lock (Section 6.1)
   Vec3 anchor = Vec3::Zero();  ///< position at the last lock check
   int age = 0;              ///< iterations since creation or the last lock check
+  /// The snake's change count when this snaxel, or its place in the snake, last
+  /// changed: housekeeping only re-examines what changed since it last looked.
+  std::uint64_t stamp = 0;
 };
 
 class Snake {
@@ -44,15 +48,17 @@ class Snake {
   double turn_degrees(int i) const;
   double length() const;
 
-  /// Removes snaxels turning more than max_degrees; returns how many.
+  /// Removes snaxels turning more than max_degrees; returns how many. Only the
+  /// snaxels whose turn changed since the last call are examined.
   int remove_sharp_turns(double max_degrees);
   /// Splits segments longer than 1.5 l and merges those shorter than 0.5 l;
-  /// returns the number of snaxels added plus removed.
+  /// returns the number of snaxels added plus removed. Only segments that changed
+  /// since the last call (with the same l) are examined.
   int resample(double l);
   /// Cuts off loops where the snake crosses itself (the side enclosing the
   /// smaller area goes); returns the number of snaxels removed. Only segments
-  /// with a moved end are checked against the others, so the snake must have
-  /// had no crossing at the previous call. Not in the paper: see Options::remove_loops.
+  /// that changed since the last call are checked against the others, so the
+  /// snake must have had no crossing then. Not in the paper: see Options::remove_loops.
   int remove_loops();
   /// Resamples every segment to spacing ~l by walking between consecutive snaxels
   /// (used when the refinement phase starts with a shorter l).
@@ -73,13 +79,25 @@ class Snake {
   const Mesh& mesh() const { return mesh_; }
 
  private:
-  Snaxel make(const SurfacePoint& p) const;
+  Snaxel make(const SurfacePoint& p);
   /// Appends the pieces - 1 points that cut segment (i, j) into equal pieces; returns how many.
-  int append_between(int i, int j, int pieces, std::vector<Snaxel>* out) const;
+  int append_between(int i, int j, int pieces, std::vector<Snaxel>* out);
+  /// Marks snaxel i as changed (and moved, so the greedy step looks at it again).
+  void touch(int i);
+  bool changed_since(int i, std::uint64_t version) const { return snaxels_[i].stamp > version; }
+  /// cos of the turning angle at i (1 for a straight snake, an open end or a zero-length segment).
+  double turn_cos(int i) const;
   const Mesh& mesh_;
   std::vector<Snaxel> snaxels_;
   bool closed_, inside_left_;
   bool nearest_resampling_ = true;
+  std::uint64_t version_ = 0;  // changes so far (stamps)
+  std::uint64_t turns_checked_ = 0, spacing_checked_ = 0, loops_checked_ = 0;  // version_ when each last looked
+  double spacing_l_ = -1;      // the l of the last resample()
+  // remove_loops() buffers: a hash grid of segment boxes, reused between calls.
+  std::vector<std::uint32_t> grid_start_;
+  std::vector<std::uint64_t> grid_keys_;
+  std::vector<std::pair<std::uint64_t, int>> grid_entries_;
 };
 
 /// Points on the surface between a and b at fractions t_k of their distance: the
