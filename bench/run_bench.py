@@ -84,11 +84,13 @@ VARIANTS = [
     ("geodesic-walk-resampling", ["neighbourhood=geodesic", "plane_fit=vertices", "nearest_resampling=0"]),
     ("geodesic-exact-q", ["neighbourhood=geodesic", "plane_fit=vertices", "exact_q=1"]),
     ("geodesic-area", ["neighbourhood=geodesic", "plane_fit=area"]),
+    ("geodesic-vertex-areas", ["neighbourhood=geodesic", "plane_fit=vertex_areas"]),
     ("euclidean", ["neighbourhood=euclidean", "plane_fit=vertices"]),
     ("euclidean-vertex-areas", ["neighbourhood=euclidean", "plane_fit=vertex_areas"]),
     ("sphere", ["neighbourhood=sphere", "plane_fit=vertices"]),
     ("sphere-vertex-areas", ["neighbourhood=sphere", "plane_fit=vertex_areas"]),
     ("sphere-area", ["neighbourhood=sphere", "plane_fit=area"]),
+    ("coarse-to-fine", ["refine_levels=0"]),
     ("convex-barrier", ["convex_barrier=1"]),
 ]
 

@@ -131,6 +131,10 @@ const std::vector<Row>& rows() {
       boolean("convex_barrier", &Options::convex_barrier,
               "also penalise P^(v) < P^(q) (experimental, not in the paper)"),
       boolean("remove_loops", &Options::remove_loops, "cut off loops where the snake crosses itself (not in the paper)"),
+      integer("refine_levels", &Options::refine_levels, "a whole number from 0 to 16",
+              [](long long n) { return n >= 0 && n <= 16; },
+              "refinement spacings: 1 = the paper (straight to half an edge); 0 = coarse to fine from h/2 in "
+              "ratios of at most 2; n = the same in at most n levels (not in the paper)"),
       boolean("nearest_resampling", &Options::nearest_resampling,
               "new snaxels at the surface point nearest the chord, not at the end of a surface walk along it"),
       neighbourhood("neighbourhood", &Options::neighbourhood,

@@ -63,6 +63,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
   if (!(o.max_turn_degrees > 0 && o.max_turn_degrees <= 180))
     throw Error("max_turn_degrees must be in (0, 180]");
   if (o.lock_interval < 1) throw Error("lock_interval must be at least 1");
+  if (o.refine_levels < 0 || o.refine_levels > 16) throw Error("refine_levels must be between 0 and 16 (1: the paper's)");
   if (o.max_iterations < 1) throw Error("max_iterations must be at least 1 (got " + std::to_string(o.max_iterations) + ")");
   if (o.threads < 0) throw Error("threads must be 0 (all cores) or a positive count (got " + std::to_string(o.threads) + ")");
   if (!(o.feature_contrast > 0) || !std::isfinite(o.feature_contrast))
@@ -246,31 +247,60 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   pre.snaxels = snake.size();
   result.phases.push_back(pre);
 
+  // The refinement's spacings: the paper goes straight to half an edge; with
+  // refine_levels != 1 the snake is refined coarse to fine, from h / 2 down to half an
+  // edge in equal ratios of at most 2 (fewer levels if refine_levels says so), each
+  // level run to convergence: the long moves into deep concavities happen at the
+  // coarse levels, in few iterations of few snaxels.
+  std::vector<double> refine_spacings = {refine.l};
+  if (options.refine_levels != 1 && 0.5 * h > refine.l * 1.05) {
+    const double span = 0.5 * h / refine.l;
+    int levels = static_cast<int>(std::ceil(std::log2(span))) + 1;
+    if (options.refine_levels > 1) levels = std::min(levels, options.refine_levels);
+    refine_spacings.clear();
+    for (int k = levels - 1; k >= 0; --k) refine_spacings.push_back(refine.l * std::pow(span, k / double(levels - 1)));
+  }
+  auto refine_level = [&](double l) {
+    PhaseSettings level = refine;
+    level.l = l;
+    level.alpha = normalise_alpha(l);
+    level.beta = normalise_beta(l, options.max_turn_degrees);
+    level.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / l : param.gamma;
+    return level;
+  };
+
   bool hit_cap = false;
   for (PhaseSettings* phase : {&coarse, &refine, &stabilise}) {
     const auto t_phase = Clock::now();
-    if (phase == &refine) snake.subdivide(refine.l);
-    snake.reset_state();
-    const PhaseOutcome outcome = run_phase(snake, feature, *phase, progress, planarity.pool());
-    if (outcome.cancelled) {
-      Result cancelled;
-      cancelled.status = Status::Cancelled;
-      cancelled.closed = options.closed;
-      return cancelled;
-    }
-    if (outcome.collapsed || (options.closed && phase == &coarse && snake.length() < 2 * h))
-      throw Error("the snake collapsed during the " + std::string(phase->name) +
-                  " phase without meeting a relief step; check that h (" + fmt(h) +
-                  ") matches the relief's step height and that the picks surround the relief");
+    const std::vector<double> spacings = phase == &refine ? refine_spacings : std::vector<double>{phase->l};
     PhaseStats stats;
     stats.name = phase->name;
-    stats.iterations = outcome.iterations;
+    for (const double l : spacings) {
+      const PhaseSettings settings = phase == &refine ? refine_level(l) : *phase;
+      if (phase == &refine) snake.subdivide(l);
+      snake.reset_state();
+      const PhaseOutcome outcome = run_phase(snake, feature, settings, progress, planarity.pool());
+      if (outcome.cancelled) {
+        Result cancelled;
+        cancelled.status = Status::Cancelled;
+        cancelled.closed = options.closed;
+        return cancelled;
+      }
+      if (outcome.collapsed || (options.closed && phase == &coarse && snake.length() < 2 * h))
+        throw Error("the snake collapsed during the " + std::string(phase->name) +
+                    " phase without meeting a relief step; check that h (" + fmt(h) +
+                    ") matches the relief's step height and that the picks surround the relief");
+      stats.iterations += outcome.iterations;
+      stats.converged = stats.converged && outcome.converged;
+    }
     stats.snaxels = snake.size();
     stats.seconds = seconds_since(t_phase);
-    stats.converged = outcome.converged;
-    hit_cap = hit_cap || !outcome.converged;
+    hit_cap = hit_cap || !stats.converged;
     result.phases.push_back(stats);
   }
+  if (refine_spacings.size() > 1)
+    result.notes.push_back("refined coarse to fine in " + std::to_string(refine_spacings.size()) + " levels (" +
+                           fmt(refine_spacings.front() / h) + " h down to " + fmt(refine_spacings.back() / h) + " h)");
 
   result.status = hit_cap ? Status::IterationCap : Status::Converged;
   result.contour = snake.points();

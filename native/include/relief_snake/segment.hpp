@@ -39,6 +39,10 @@ struct Options {
   bool scale_feature_with_spacing = true;  ///< gamma scales with 1/l between phases, like alpha
   bool convex_barrier = false;     ///< penalise sitting on the step's top edge (not in the paper)
   bool remove_loops = true;        ///< cut off loops where the snake crosses itself (not in the paper)
+  /// Refinement levels: 1 = the paper (straight from l = h to half an edge); otherwise the
+  /// refinement goes coarse to fine from h / 2 to half an edge, in equal ratios of at most 2
+  /// (0: that many levels) or in at most n levels (not in the paper).
+  int refine_levels = 1;
   /// New snaxels (splits, merges, the refinement's subdivision) at the surface point nearest the
   /// chord between their neighbours, instead of the end of a straight surface walk along it.
   bool nearest_resampling = true;
