@@ -131,6 +131,9 @@ const std::vector<Row>& rows() {
       boolean("convex_barrier", &Options::convex_barrier,
               "also penalise P^(v) < P^(q) (experimental, not in the paper)"),
       boolean("remove_loops", &Options::remove_loops, "cut off loops where the snake crosses itself (not in the paper)"),
+      boolean("foot_snap", &Options::foot_snap,
+              "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
+              "the background (not in the paper)"),
       integer("refine_levels", &Options::refine_levels, "a whole number from 0 to 16",
               [](long long n) { return n >= 0 && n <= 16; },
               "refinement spacings: 1 = the paper (straight to half an edge); 0 = coarse to fine from h/2 in "

@@ -9,6 +9,7 @@
 #include "relief_snake/energy.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/evolution.hpp"
+#include "relief_snake/foot.hpp"
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/planarity.hpp"
 #include "relief_snake/region.hpp"
@@ -301,6 +302,24 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   if (refine_spacings.size() > 1)
     result.notes.push_back("refined coarse to fine in " + std::to_string(refine_spacings.size()) + " levels (" +
                            fmt(refine_spacings.front() / h) + " h down to " + fmt(refine_spacings.back() / h) + " h)");
+
+  if (options.foot_snap) {
+    FootOptions fo;
+    fo.h = h;
+    const FootResult foot = settle_at_foot(&snake, fo);
+    // Moving out can twist neighbours (rays from a jagged snake cross): cut the loops
+    // (each call removes at most 64) and the sharp turns again.
+    for (int guard = 0; guard < 100 && snake.remove_loops() > 0; ++guard) {
+    }
+    snake.remove_sharp_turns(options.max_turn_degrees);
+    if (foot.noisy)
+      result.notes.push_back("not settled at the foot: the background is too noisy (residual " +
+                             fmt(foot.background_residual / h) + " h)");
+    else
+      result.notes.push_back("settled at the foot: " + std::to_string(foot.moved) + " snaxels moved out by " +
+                             fmt(foot.mean_move / h) + " h on average, " + std::to_string(foot.skipped) +
+                             " left (no clean background outside)");
+  }
 
   result.status = hit_cap ? Status::IterationCap : Status::Converged;
   result.contour = snake.points();

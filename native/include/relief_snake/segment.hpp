@@ -43,6 +43,9 @@ struct Options {
   /// refinement goes coarse to fine from h / 2 to half an edge, in equal ratios of at most 2
   /// (0: that many levels) or in at most n levels (not in the paper).
   int refine_levels = 1;
+  /// After stabilisation, move each snaxel out to the foot of the step, where the surface
+  /// leaves the background continued from outside (foot.hpp; not in the paper).
+  bool foot_snap = false;
   /// New snaxels (splits, merges, the refinement's subdivision) at the surface point nearest the
   /// chord between their neighbours, instead of the end of a straight surface walk along it.
   bool nearest_resampling = true;

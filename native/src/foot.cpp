@@ -1,0 +1,178 @@
+#include "relief_snake/foot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace relief_snake {
+
+namespace {
+
+// Snaxel i's inward direction from its neighbours `span` snaxels away: a jagged snake's
+// own bisectors point every which way, and moves along them would twist it.
+Vec3 smooth_inward(const Snake& snake, int i, int span) {
+  const int n = snake.size();
+  auto at = [&](int j) {
+    if (snake.closed()) return snake[((j % n) + n) % n].position;
+    return snake[std::clamp(j, 0, n - 1)].position;
+  };
+  const Vec3 nrm = normal(snake.mesh(), snake[i].point);
+  Vec3 t = at(i + span) - at(i - span);
+  t -= t.dot(nrm) * nrm;
+  const Vec3 own = snake.inward(i);
+  if (!(t.norm() > 0)) return own;
+  Vec3 m = nrm.cross(t.normalized());
+  if (m.dot(own) < 0) m = -m;  // the side the snake's own inward direction says
+  return m;
+}
+
+// The foot distance (>= 0) outwards from snaxel i along `inward`, or a negative value to leave it.
+double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
+                     std::vector<double>* distances, std::vector<SurfacePoint>* samples, double* band_residual) {
+  const Mesh& mesh = snake.mesh();
+  if (inward.isZero()) return -1;
+  const double h = o.h;
+  // Samples every h / 20 (and at least every half edge) out to the band's end.
+  const double step = std::min(0.05 * h, 0.5 * mesh.average_edge_length());
+  const int count = static_cast<int>(std::ceil(o.band_to * h / step));
+  distances->resize(count + 1);
+  for (int k = 0; k <= count; ++k) (*distances)[k] = k * step;
+  walk_sampled(mesh, snake[i].point, -inward, *distances, samples);
+  if (static_cast<int>(samples->size()) <= count) return -1;  // the mesh ends before the band does
+
+  // The background's normal: the surface normal averaged over the band.
+  const int band_start = static_cast<int>(std::ceil(o.band_from * h / step));
+  Vec3 n = Vec3::Zero();
+  for (int k = band_start; k <= count; ++k) n += normal(mesh, (*samples)[k]);
+  if (!(n.norm() > 0)) return -1;
+  n.normalize();
+  const Vec3 origin = position(mesh, (*samples)[count]);
+  auto height = [&](int k) { return (position(mesh, (*samples)[k]) - origin).dot(n); };
+
+  // A quadratic profile z(d) = a + b d + c d^2 through the band (least squares, d in h).
+  const int m = count - band_start + 1;
+  if (m < 4) return -1;
+  Eigen::MatrixXd A(m, 3);
+  Eigen::VectorXd z(m);
+  for (int k = band_start; k <= count; ++k) {
+    const double d = (*distances)[k] / h;
+    A.row(k - band_start) << 1.0, d, d * d;
+    z(k - band_start) = height(k);
+  }
+  const Eigen::Vector3d coef = A.colPivHouseholderQr().solve(z);
+  const double residual = std::sqrt((A * coef - z).squaredNorm() / m);
+  *band_residual = residual;
+  if (!(residual <= o.max_residual * h)) return -1;  // no clean background outside this snaxel
+  const double threshold = std::max(4 * residual, 0.02 * h);
+  auto above = [&](int k) {
+    const double d = (*distances)[k] / h;
+    return height(k) - (coef(0) + coef(1) * d + coef(2) * d * d);
+  };
+  if (above(0) <= threshold) return 0;  // the snaxel is on the background already
+  // From the band inwards, the first sample that rises above the background ends it.
+  for (int k = band_start - 1; k >= 0; --k)
+    if (above(k) > threshold) return k + 1 < band_start ? (*distances)[k + 1] : -1;
+  return 0;
+}
+
+}  // namespace
+
+FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
+  FootResult result;
+  const int n = snake->size();
+  std::vector<double> foot(n, -1), distances;
+  std::vector<SurfacePoint> samples;
+  std::vector<Vec3> inward(n, Vec3::Zero());
+  std::vector<double> residuals;
+  for (int i = 0; i < n; ++i) {
+    if (snake->is_end(i)) continue;
+    inward[i] = smooth_inward(*snake, i, o.smoothing + 1);
+    double residual = -1;
+    foot[i] = foot_distance(*snake, i, inward[i], o, &distances, &samples, &residual);
+    if (residual >= 0) residuals.push_back(residual);
+  }
+  // A noisy background hides where the surface leaves it: measured, the snap then puts
+  // snaxels on noise bumps outside the foot. Leave such a contour as it is.
+  if (!residuals.empty()) {
+    std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+    result.background_residual = residuals[residuals.size() / 2];
+  }
+  if (result.background_residual > o.max_noise * o.h) {
+    result.skipped = n;
+    result.noisy = true;
+    return result;
+  }
+  // Median filter along the snake over the snaxels that have a foot.
+  std::vector<double> window, smoothed(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (foot[i] < 0) continue;
+    window.clear();
+    for (int k = -o.smoothing; k <= o.smoothing; ++k) {
+      int j = i + k;
+      if (snake->closed()) j = ((j % n) + n) % n;
+      else if (j < 0 || j >= n) continue;
+      if (foot[j] >= 0) window.push_back(foot[j]);
+    }
+    std::nth_element(window.begin(), window.begin() + window.size() / 2, window.end());
+    smoothed[i] = window[window.size() / 2];
+  }
+  // Never move more than 40% of the way to another part of the snake (the far wall
+  // of a narrow slot the snake went into, whose snaxels move towards these): the two
+  // sides must not meet.
+  {
+    const double cell = 0.5 * o.h;
+    std::unordered_map<std::uint64_t, std::vector<int>> grid;
+    auto key = [&](const Vec3& p) {
+      const Eigen::Array3i c = (p / cell).array().floor().cast<int>();
+      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x())) << 42) ^
+             (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y())) << 21) ^
+             static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()));
+    };
+    for (int i = 0; i < n; ++i) grid[key((*snake)[i].position)].push_back(i);
+    const int apart = 4 * o.smoothing + 4;  // snaxels closer along the snake are its own side
+    for (int i = 0; i < n; ++i) {
+      if (!(smoothed[i] > 0)) continue;
+      const Vec3& p = (*snake)[i].position;
+      const Eigen::Array3i c = (p / cell).array().floor().cast<int>();
+      double nearest = std::numeric_limits<double>::infinity();
+      const int reach = static_cast<int>(std::ceil(smoothed[i] / (0.4 * cell))) + 1;
+      for (int x = -reach; x <= reach; ++x)
+        for (int y = -reach; y <= reach; ++y)
+          for (int z = -reach; z <= reach; ++z) {
+            const auto it = grid.find(key(((c + Eigen::Array3i(x, y, z)).cast<double>() + 0.5) * cell));
+            if (it == grid.end()) continue;
+            for (int j : it->second) {
+              int gap = std::abs(i - j);
+              if (snake->closed()) gap = std::min(gap, n - gap);
+              if (gap > apart) nearest = std::min(nearest, ((*snake)[j].position - p).norm());
+            }
+          }
+      smoothed[i] = std::min(smoothed[i], 0.4 * nearest);
+    }
+  }
+  // Move (all outward steps are computed from the snake as it was).
+  std::vector<SurfacePoint> target(n);
+  for (int i = 0; i < n; ++i) {
+    target[i] = (*snake)[i].point;
+    if (smoothed[i] > 0) target[i] = walk(snake->mesh(), (*snake)[i].point, -inward[i], smoothed[i]).end;
+  }
+  double total = 0;
+  for (int i = 0; i < n; ++i) {
+    if (smoothed[i] < 0) {
+      ++result.skipped;
+    } else if (smoothed[i] > 0) {
+      snake->move(i, target[i]);
+      ++result.moved;
+      total += smoothed[i];
+    }
+  }
+  result.mean_move = result.moved ? total / result.moved : 0;
+  return result;
+}
+
+}  // namespace relief_snake
