@@ -17,7 +17,7 @@ Sections:
     far and zigzag starts, curved backgrounds, sharp/blended steps, a drop inside the
     edge, an open noisy contour, the decimated duck, slots of mouth 2..8 average edges),
     each run with the default options, the paper's method (PAPER) and one-change variants;
-  * sensitivity (60k-triangle duck): h factor, W_int, noise;
+  * sensitivity (the ~290k Figure 6 duck, for SWEEP_CONFIGS): h factor, W_int, noise;
   * speed and memory: the ~290k duck per phase beside the paper's Figure 6, and a scaling
     series 50k..2M triangles (run one at a time so timings are not shared with another run).
 
@@ -91,11 +91,13 @@ VARIANTS = [
     ("sphere-vertex-areas", ["neighbourhood=sphere", "plane_fit=vertex_areas"]),
     ("sphere-area", ["neighbourhood=sphere", "plane_fit=area"]),
     ("coarse-to-fine", ["refine_levels=0"]),
+    ("foot-snap", ["foot_snap=1"]),
+    ("foot-snap+coarse-to-fine", ["foot_snap=1", "refine_levels=0"]),
     ("convex-barrier", ["convex_barrier=1"]),
 ]
 
 # The sensitivity sweeps run for these configurations.
-SWEEP_CONFIGS = [("default", []), ("paper", PAPER)]
+SWEEP_CONFIGS = [("default", []), ("paper", PAPER), ("foot-snap", ["foot_snap=1"])]
 
 
 @dataclass
@@ -718,6 +720,7 @@ def write_report(results, machine, started, wall, load_start, load_end, build_di
     n_meet = sum(meets(r) for r in default_rows)
     tol = tolerance_range([r for r in results["sens_h"] if r.get("config") == "default"])
     tol_paper = tolerance_range([r for r in results["sens_h"] if r.get("config") == "paper"])
+    tol_foot = tolerance_range([r for r in results["sens_h"] if r.get("config") == "foot-snap"])
     slots_row = suite.get(("slots", "default"))
     entered = None
     slots_valid = bool(slots_row and slots_row.get("ok") and slots_row["score"]["iou"] >= SLOTS_MIN_IOU)
@@ -745,13 +748,19 @@ def write_report(results, machine, started, wall, load_start, load_end, build_di
                       f"{f(r2m.get('peak_mb'), 0)} MB", mark(r2m.get("peak_mb", 1e9) <= TARGET_2M_MB)])
     growth = growth_exponent(scaling)
     if growth is not None:
+        top = [r for r in scaling if r.get("engine_seconds") and r.get("triangles")][-2:]
+        local = (math.log(top[1]["engine_seconds"] / top[0]["engine_seconds"]) /
+                 math.log(top[1]["triangles"] / top[0]["triangles"])) if len(top) == 2 else None
         trows.append(["growth of engine time with size", "≤ linear (exponent ≤ 1)",
-                      f"exponent {growth:.2f} (log-log fit, all sizes)", mark(growth <= 1.05)])
+                      f"exponent {growth:.2f} (log-log fit, all sizes)" +
+                      (f"; {local:.2f} between the two largest sizes" if local is not None else ""),
+                      mark(growth <= 1.05)])
     trows.append(["suite cases meeting mean ≤ 0.5, p95 ≤ 1.5 (both ways), IoU ≥ 0.97 (default options)",
                   f"all {len(SUITE)}", f"{n_meet} of {len(default_rows)}", mark(n_meet == len(SUITE))])
     trows.append([f"h range with the same accuracy ({sweeps['sens_triangles'] // 1000}k duck sweep, default options)",
                   "x0.6 … x1.4 (the paper's range for Figure 6)",
-                  (tol if tol else "none of the sweep points") + f"; the paper's method here: {tol_paper or 'none'}",
+                  (tol if tol else "none of the sweep points") + f"; the paper's method here: {tol_paper or 'none'}"
+                  + f"; with `foot_snap=1`: {tol_foot or 'none'}",
                   mark(tol_ok([r for r in results["sens_h"] if r.get("config") == "default"]))])
     trows.append(["narrowest slot mouth entered (≥ 50% of its vertices uncovered)", "paper: 4–6 average edges",
                   (f"{entered:g} average edges" if entered is not None else "none entered") if slots_valid else
@@ -926,8 +935,9 @@ def write_report(results, machine, started, wall, load_start, load_end, build_di
     # Sensitivity.
     L.append("## Sensitivity (duck, blended step, %dk triangles: the Figure 6 analogue)" % (sweeps["sens_triangles"] // 1000))
     L.append("")
-    L.append("Two configurations: **default** (the engine's defaults) and **paper** (" +
-             " ".join(f"`{o}`" for o in PAPER) + "). Engine seconds are single-thread.")
+    L.append("Three configurations: **default** (the engine's defaults), **paper** (" +
+             " ".join(f"`{o}`" for o in PAPER) + ") and **foot-snap** (`foot_snap=1`). Engine seconds are "
+             "single-thread.")
     L.append("")
     for key, title, xname, png in [("sens_h", "h given / true step", "h factor", "sensitivity_h.png"),
                                    ("sens_wint", "W_int", "W_int", "sensitivity_wint.png"),
@@ -945,7 +955,7 @@ def write_report(results, machine, started, wall, load_start, load_end, build_di
         L.append(table(["config", xname, "status", "IoU", "mean →", "p95 →", "mean ←", "p95 ←", "engine s",
                         "targets met", "error"], rows))
         L.append("")
-    for cname, rng in (("default", tol), ("paper", tol_paper)):
+    for cname, rng in (("default", tol), ("paper", tol_paper), ("foot-snap", tol_foot)):
         L.append(f"{cname}: all accuracy targets hold for h in " + (f"{rng} of the true step" if rng else
                  "no contiguous range around x1") + f" (sweep points {', '.join(f'{x:g}' for x in sweeps['h_factors'])}).")
         L.append("")

@@ -3,6 +3,7 @@
 // boundary on average, and the relief region has IoU >= 0.95 with the truth.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 #include "relief_snake/segment.hpp"
@@ -22,6 +23,7 @@ struct Case {
   syn::Start start = syn::Start::Near;
   double h_factor = 1.0;  ///< the h the user gives, relative to the true step
   double noise = 0;
+  std::function<void(Options&)> tweak;  ///< options beyond the defaults
 };
 
 std::ostream& operator<<(std::ostream& os, const Case& c) { return os << c.name; }
@@ -46,6 +48,7 @@ TEST_P(SegmentScan, FindsTheReliefBoundary) {
   options.step_height = c.h_factor * scan.h;
   options.closed = picks.closed;
   options.relief_side = picks.relief_side;
+  if (c.tweak) c.tweak(options);
   const Result result = segment(mesh, picks.vertices, options);
 
   EXPECT_EQ(result.status, Status::Converged);
@@ -105,6 +108,30 @@ std::vector<Case> cases() {
   out.push_back(saddle);
   Case open = make("open_relief", syn::Shape::Open, syn::Step::Blended);
   out.push_back(open);
+  // One-triangle walls: new snaxels nearest the chord keep the refinement off the wall.
+  Case duck_sharp = make("duck_sharp", syn::Shape::Duck, syn::Step::Sharp);
+  duck_sharp.triangles = 150000;
+  out.push_back(duck_sharp);
+  Case rectangle = make("rectangle_sharp", syn::Shape::Rectangle, syn::Step::Sharp);
+  rectangle.triangles = 100000;
+  out.push_back(rectangle);
+  // The paper's planarity (geodesic ball, vertex fit) on a case it handles.
+  Case paper = make("duck_paper_planarity", syn::Shape::Duck, syn::Step::Blended);
+  paper.triangles = 150000;
+  paper.tweak = [](Options& o) {
+    o.neighbourhood = Neighbourhood::Geodesic;
+    o.plane_fit = PlaneFit::Vertices;
+  };
+  out.push_back(paper);
+  Case levels = make("duck_coarse_to_fine", syn::Shape::Duck, syn::Step::Blended);
+  levels.triangles = 150000;
+  levels.tweak = [](Options& o) { o.refine_levels = 0; };
+  out.push_back(levels);
+  Case foot = make("duck_h_x0.6_foot_snap", syn::Shape::Duck, syn::Step::Blended);
+  foot.triangles = 150000;
+  foot.h_factor = 0.6;
+  foot.tweak = [](Options& o) { o.foot_snap = true; };
+  out.push_back(foot);
   return out;
 }
 

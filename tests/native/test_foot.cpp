@@ -1,0 +1,71 @@
+// Settling a contour at the foot of the step (foot.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "relief_snake/foot.hpp"
+#include "synthetic.hpp"
+
+using namespace relief_snake;
+namespace syn = relief_snake::synthetic;
+
+namespace {
+
+// A closed snake on the circle of radius r around the disk relief's centre (counter-
+// clockwise, relief inside), through the vertices nearest to it.
+Snake circle_snake(const Mesh& mesh, const syn::Scan& scan, double r, int n) {
+  std::vector<SurfacePoint> points;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * M_PI * k / n;
+    points.push_back(vertex_point(mesh, scan.nearest_vertex(r * std::cos(a), r * std::sin(a))));
+  }
+  return Snake(mesh, points, true, true);
+}
+
+double mean_radius(const Snake& snake) {
+  double sum = 0;
+  for (int i = 0; i < snake.size(); ++i) sum += std::hypot(snake[i].position.x(), snake[i].position.y());
+  return sum / snake.size();
+}
+
+}  // namespace
+
+TEST(Foot, MovesASnakeFromTheSlopeOutToTheFoot) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;  // radius 12: the foot of the blended step is at r = 12
+  spec.step = syn::Step::Blended;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  Snake snake = circle_snake(mesh, scan, 11.75, 150);  // a quarter h up the slope
+  ASSERT_LT(mean_radius(snake), 11.85);
+  FootOptions o;
+  o.h = scan.h;
+  const FootResult r = settle_at_foot(&snake, o);
+  EXPECT_FALSE(r.noisy);
+  EXPECT_GT(r.moved, 120);  // most of the 150
+  EXPECT_NEAR(mean_radius(snake), 12.0, 0.1);
+  // Already at the foot: (almost) nothing moves.
+  Snake outside = circle_snake(mesh, scan, 12.3, 150);
+  const double before = mean_radius(outside);
+  settle_at_foot(&outside, o);
+  EXPECT_NEAR(mean_radius(outside), before, 0.03);
+}
+
+TEST(Foot, LeavesANoisyBackgroundAlone) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.triangles = 60000;
+  spec.noise = 0.05;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  Snake snake = circle_snake(mesh, scan, 11.75, 300);
+  const double before = mean_radius(snake);
+  FootOptions o;
+  o.h = scan.h;
+  const FootResult r = settle_at_foot(&snake, o);
+  EXPECT_TRUE(r.noisy);
+  EXPECT_EQ(r.moved, 0);
+  EXPECT_EQ(mean_radius(snake), before);
+}
