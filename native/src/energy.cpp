@@ -76,9 +76,8 @@ void FeatureEnergy::trace(const SurfacePoint& x, const Vec3& inward, const doubl
   std::sort(wanted.begin(), wanted.begin() + n);
   std::array<double, 3 * 64 + 6> distances;
   for (int i = 0; i < n; ++i) distances[i] = wanted[i].first;
-  const Walk w = walk_trace(planarity_.mesh(), x, inward, distances.data(), n, exact_q_ ? q_from_ + lo : 0,
-                            exact_q_ ? q_to_ + hi : -1, &out->points);
-  (void)w;
+  walk_trace(planarity_.mesh(), x, inward, distances.data(), n, exact_q_ ? q_from_ + lo : 0, exact_q_ ? q_to_ + hi : -1,
+             &out->points);
   for (WalkPoint& p : out->points)
     if (p.tag >= 0) p.tag = wanted[p.tag].second;
 }

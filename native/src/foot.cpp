@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "grid_key.hpp"
+
 namespace relief_snake {
 
 namespace {
@@ -127,24 +129,18 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   {
     const double cell = 0.5 * o.h;
     std::unordered_map<std::uint64_t, std::vector<int>> grid;
-    auto key = [&](const Vec3& p) {
-      const Eigen::Array3i c = (p / cell).array().floor().cast<int>();
-      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x())) << 42) ^
-             (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y())) << 21) ^
-             static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()));
-    };
-    for (int i = 0; i < n; ++i) grid[key((*snake)[i].position)].push_back(i);
+    for (int i = 0; i < n; ++i) grid[grid_key(grid_cell((*snake)[i].position, cell))].push_back(i);
     const int apart = 4 * o.smoothing + 4;  // snaxels closer along the snake are its own side
     for (int i = 0; i < n; ++i) {
       if (!(smoothed[i] > 0)) continue;
       const Vec3& p = (*snake)[i].position;
-      const Eigen::Array3i c = (p / cell).array().floor().cast<int>();
+      const Eigen::Array3i c = grid_cell(p, cell);
       double nearest = std::numeric_limits<double>::infinity();
       const int reach = static_cast<int>(std::ceil(smoothed[i] / (0.4 * cell))) + 1;
       for (int x = -reach; x <= reach; ++x)
         for (int y = -reach; y <= reach; ++y)
           for (int z = -reach; z <= reach; ++z) {
-            const auto it = grid.find(key(((c + Eigen::Array3i(x, y, z)).cast<double>() + 0.5) * cell));
+            const auto it = grid.find(grid_key(c + Eigen::Array3i(x, y, z)));
             if (it == grid.end()) continue;
             for (int j : it->second) {
               int gap = std::abs(i - j);

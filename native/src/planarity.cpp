@@ -411,14 +411,13 @@ void PlanarityField::prefetch_raw(const std::vector<int>& vertices) {
   }
   for (int v : batch_) queued[v] = 0;
   if (batch_.empty()) return;
-  if (batch_.size() >= 2 && options_.threads != 1 && !pool_) pool_ = std::make_unique<WorkerPool>(options_.threads);
-  if (batch_.size() < 2 || !pool_ || pool_->size() == 1) {
+  WorkerPool* workers = batch_.size() >= 2 ? pool() : nullptr;
+  if (!workers || workers->size() == 1) {
     for (int v : batch_) raw(v);
     return;
   }
-  for (int w = 0; w < pool_->size(); ++w) scratch(w);  // allocate before the threads start
   // Each item writes only its own raw_ entry; compute_raw reads nothing shared but the mesh.
-  pool_->run(static_cast<int>(batch_.size()),
+  workers->run(static_cast<int>(batch_.size()),
              [this](int item, int worker) { raw_[batch_[item]] = compute_raw(batch_[item], scratch_[worker]); });
   raw_count_ += batch_.size();
 }

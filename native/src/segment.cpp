@@ -226,16 +226,21 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   coarse.w_int = coarse.w_f = coarse.w_d = 1;
   coarse.gamma_sigma2 = param.gamma * param.sigma_background * param.sigma_background;
 
+  // A refinement setting at spacing l: alpha and beta normalised for l, gamma scaled with 1/l.
+  auto at_spacing = [&](PhaseSettings settings, double l) {
+    settings.l = l;
+    settings.alpha = normalise_alpha(l);
+    settings.beta = normalise_beta(l, options.max_turn_degrees);
+    settings.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / l : param.gamma;
+    return settings;
+  };
   PhaseSettings refine = base;
   refine.name = "refine";
-  refine.l = param.refine_spacing;
-  refine.alpha = param.alpha_refine;
-  refine.beta = param.beta_refine;
-  refine.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / refine.l : param.gamma;
   refine.w_int = param.w_int;
   refine.w_f = param.w_f;
   refine.w_d = param.w_d;
   refine.gamma_sigma2 = 0;
+  refine = at_spacing(refine, param.refine_spacing);
 
   PhaseSettings stabilise = refine;
   stabilise.name = "stabilise";
@@ -261,14 +266,6 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     refine_spacings.clear();
     for (int k = levels - 1; k >= 0; --k) refine_spacings.push_back(refine.l * std::pow(span, k / double(levels - 1)));
   }
-  auto refine_level = [&](double l) {
-    PhaseSettings level = refine;
-    level.l = l;
-    level.alpha = normalise_alpha(l);
-    level.beta = normalise_beta(l, options.max_turn_degrees);
-    level.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / l : param.gamma;
-    return level;
-  };
 
   bool hit_cap = false;
   for (PhaseSettings* phase : {&coarse, &refine, &stabilise}) {
@@ -277,7 +274,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     PhaseStats stats;
     stats.name = phase->name;
     for (const double l : spacings) {
-      const PhaseSettings settings = phase == &refine ? refine_level(l) : *phase;
+      const PhaseSettings settings = phase == &refine ? at_spacing(refine, l) : *phase;
       if (phase == &refine) snake.subdivide(l);
       snake.reset_state();
       const PhaseOutcome outcome = run_phase(snake, feature, settings, progress, planarity.pool());

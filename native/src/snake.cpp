@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "grid_key.hpp"
+
 namespace relief_snake {
 
 namespace {
@@ -197,15 +199,7 @@ double Snake::local_length(int i) const {
   return 0.5 * ((x - snaxels_[ip].position).norm() + (snaxels_[in].position - x).norm());
 }
 
-double Snake::turn_degrees(int i) const {
-  const int ip = prev(i), in = next(i);
-  if (ip < 0 || in < 0) return 0;
-  const Vec3 a = snaxels_[i].position - snaxels_[ip].position;
-  const Vec3 b = snaxels_[in].position - snaxels_[i].position;
-  const double na = a.norm(), nb = b.norm();
-  if (!(na > 0) || !(nb > 0)) return 0;
-  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * kDegrees;
-}
+double Snake::turn_degrees(int i) const { return std::acos(turn_cos(i)) * kDegrees; }
 
 double Snake::length() const {
   double total = 0;
@@ -362,15 +356,7 @@ int Snake::remove_loops() {
       *lo = p0.cwiseMin(p1) - Vec3::Constant(margin);
       *hi = p0.cwiseMax(p1) + Vec3::Constant(margin);
     };
-    auto cell_of = [&](int i) {
-      const Vec3 mid = 0.5 * (snaxels_[i].position + snaxels_[next(i)].position);
-      return Eigen::Array3i((mid / cell).array().floor().cast<int>());
-    };
-    auto key_of = [](const Eigen::Array3i& c) {
-      return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x())) << 42) ^
-             (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y())) << 21) ^
-             static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()));
-    };
+    auto cell_of = [&](int i) { return grid_cell(0.5 * (snaxels_[i].position + snaxels_[next(i)].position), cell); };
     std::uint32_t buckets = 1;
     while (buckets < 2u * static_cast<std::uint32_t>(segments)) buckets <<= 1;
     auto bucket_of = [&](std::uint64_t key) {
@@ -380,7 +366,7 @@ int Snake::remove_loops() {
     grid_keys_.resize(segments);
     grid_start_.assign(buckets + 1, 0);
     for (int i = 0; i < segments; ++i) {
-      grid_keys_[i] = key_of(cell_of(i));
+      grid_keys_[i] = grid_key(cell_of(i));
       ++grid_start_[bucket_of(grid_keys_[i]) + 1];
     }
     for (std::uint32_t k = 0; k < buckets; ++k) grid_start_[k + 1] += grid_start_[k];
@@ -394,7 +380,7 @@ int Snake::remove_loops() {
       for (int x = -1; x <= 1; ++x)
         for (int y = -1; y <= 1; ++y)
           for (int z = -1; z <= 1; ++z) {
-            const std::uint64_t key = key_of(c + Eigen::Array3i(x, y, z));
+            const std::uint64_t key = grid_key(c + Eigen::Array3i(x, y, z));
             const std::uint32_t bucket = bucket_of(key);
             for (std::uint32_t e = grid_start_[bucket]; e < grid_start_[bucket + 1]; ++e)
               if (grid_entries_[e].first == key) visit(grid_entries_[e].second);
@@ -487,20 +473,20 @@ bool Snake::within(const std::vector<Vec3>& old, double tolerance) const {
   double longest = 0;
   for (int k = 0; k < segments; ++k) longest = std::max(longest, (old[(k + 1) % m] - old[k]).norm());
   const double cell = std::max(longest, tolerance) + tolerance;
-  auto key = [cell](long long x, long long y, long long z) { return (x * 73856093LL) ^ (y * 19349663LL) ^ (z * 83492791LL); };
-  std::unordered_map<long long, std::vector<int>> grid;
+  std::unordered_map<std::uint64_t, std::vector<int>> grid;
   grid.reserve(static_cast<std::size_t>(segments) * 2);
   for (int k = 0; k < segments; ++k) {
     const Vec3 &a = old[k], &b = old[(k + 1) % m];
     const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(tolerance), hi = a.cwiseMax(b) + Vec3::Constant(tolerance);
-    for (long long x = std::floor(lo.x() / cell); x <= std::floor(hi.x() / cell); ++x)
-      for (long long y = std::floor(lo.y() / cell); y <= std::floor(hi.y() / cell); ++y)
-        for (long long z = std::floor(lo.z() / cell); z <= std::floor(hi.z() / cell); ++z) grid[key(x, y, z)].push_back(k);
+    const Eigen::Array3i c0 = grid_cell(lo, cell), c1 = grid_cell(hi, cell);
+    for (int x = c0.x(); x <= c1.x(); ++x)
+      for (int y = c0.y(); y <= c1.y(); ++y)
+        for (int z = c0.z(); z <= c1.z(); ++z) grid[grid_key(Eigen::Array3i(x, y, z))].push_back(k);
   }
   const double t2 = tolerance * tolerance;
   for (const Snaxel& s : snaxels_) {
     const Vec3& p = s.position;
-    const auto it = grid.find(key(std::floor(p.x() / cell), std::floor(p.y() / cell), std::floor(p.z() / cell)));
+    const auto it = grid.find(grid_key(grid_cell(p, cell)));
     bool near = false;
     if (it != grid.end()) {
       for (int k : it->second) {

@@ -246,12 +246,20 @@ Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, do
   return walk_impl(mesh, start, direction, &distance, 1, nullptr);
 }
 
+namespace {
+
+void keep_points(const std::vector<WalkPoint>& traced, std::vector<SurfacePoint>* out) {
+  out->clear();
+  for (const WalkPoint& p : traced) out->push_back(p.point);
+}
+
+}  // namespace
+
 Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
                   const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
   std::vector<WalkPoint> points;
   const Walk w = walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), &points);
-  samples->clear();
-  for (const WalkPoint& p : points) samples->push_back(p.point);
+  keep_points(points, samples);
   return w;
 }
 
@@ -336,8 +344,7 @@ Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direc
   std::vector<WalkPoint> traced;
   const double ends[2] = {from, to};
   const Walk w = walk_trace(mesh, start, direction, ends, to > from ? 2 : 1, from, to, &traced);
-  points->clear();
-  for (const WalkPoint& p : traced) points->push_back(p.point);
+  keep_points(traced, points);
   return w;
 }
 
