@@ -35,7 +35,7 @@ namespace {
 
 const char* kUsage =
     "usage:\n"
-    "  relief-snake segment MESH --picks I,J,K,... --step-height H [options]\n"
+    "  relief-snake segment MESH --picks I,J,K,... [--step-height H|auto] [options]\n"
     "  relief-snake measure MESH I J\n"
     "  relief-snake info MESH\n"
     "  relief-snake --help\n"
@@ -45,10 +45,13 @@ const char* kUsage =
     "\n"
     "segment: find the outline of the relief around (or beside) the picked vertices.\n"
     "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open)\n"
-    "  --step-height H        the relief's step height, in mesh units (> 0; see 'measure')\n"
-    "  --w-int W              internal-energy weight for refinement, in (0, 1] (default 0.25)\n"
+    "  --step-height H|auto   the relief's step height, in mesh units (> 0; see 'measure'); auto (the\n"
+    "                         default): estimated from the picks and the surface\n"
+    "  --w-int W|auto         internal-energy weight for refinement, in (0, 1]; auto (the default):\n"
+    "                         the engine tries 0.25, 0.5 and 1 until its self-check holds\n"
     "  --open                 open contour that ends on the mesh boundary\n"
-    "  --relief-side left|right  with --open: side of the relief along the pick order (default left)\n"
+    "  --relief-side left|right|auto  with --open: side of the relief along the pick order\n"
+    "                         (default auto: the side that rises)\n"
     "  --max-iterations N     iteration cap per phase (default 3000)\n"
     "  --option NAME=VALUE    set an advanced option (repeatable; see 'advanced options' below)\n"
     "  --out FILE             write the JSON result to FILE instead of stdout\n"
@@ -56,7 +59,8 @@ const char* kUsage =
     "measure: straight-line distance between vertices I and J (to estimate H).\n"
     "info: what intake made of the mesh (merged, triangulated, refused faces, ...).\n"
     "\n"
-    "exit codes: 0 success, 1 bad input or failed segmentation, 2 usage error\n";
+    "exit codes: 0 success, 1 bad input or failed segmentation, 2 usage error,\n"
+    "  3 result written but doubtful or stopped at the iteration cap (see its status and message)\n";
 
 /// A malformed command line (exit code 2).
 struct UsageError : std::runtime_error {
@@ -243,10 +247,15 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       a.picks = parse_picks(take_value());
       a.have_picks = true;
     } else if (name == "--step-height") {
-      a.options.step_height = parse_number(take_value(), "--step-height");
+      const std::string value = take_value();
+      a.options.step_height = value == "auto" ? rs::kAuto : parse_number(value, "--step-height");
+      if (value != "auto" && !(a.options.step_height > 0)) throw UsageError("--step-height must be > 0 or auto");
       a.have_height = true;
     } else if (name == "--w-int") {
-      a.options.w_int = parse_number(take_value(), "--w-int");
+      const std::string value = take_value();
+      a.options.w_int = value == "auto" ? rs::kAuto : parse_number(value, "--w-int");
+      if (value != "auto" && !(a.options.w_int > 0 && a.options.w_int <= 1))
+        throw UsageError("--w-int must be in (0, 1] or auto");
     } else if (name == "--open") {
       no_value();
       a.options.closed = false;
@@ -256,8 +265,10 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
         a.options.relief_side = rs::ReliefSide::Left;
       else if (side == "right")
         a.options.relief_side = rs::ReliefSide::Right;
+      else if (side == "auto")
+        a.options.relief_side = rs::ReliefSide::Auto;
       else
-        throw UsageError("--relief-side must be 'left' or 'right', got '" + side + "'");
+        throw UsageError("--relief-side must be 'left', 'right' or 'auto', got '" + side + "'");
       a.have_side = true;
     } else if (name == "--max-iterations") {
       const std::int64_t n = parse_index(take_value(), "--max-iterations");
@@ -283,9 +294,6 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
                                                                             " arguments");
   a.mesh_path = positional[0];
   if (!a.have_picks) throw UsageError("segment needs --picks I,J,K,... (0-based vertex indices around the relief)");
-  if (!a.have_height) throw UsageError("segment needs --step-height H (measure it with 'relief-snake measure')");
-  if (!(a.options.step_height > 0)) throw UsageError("--step-height must be > 0");
-  if (!(a.options.w_int > 0 && a.options.w_int <= 1)) throw UsageError("--w-int must be in (0, 1]");
   if (a.have_side && a.options.closed) throw UsageError("--relief-side only applies with --open");
   const std::size_t min_picks = a.options.closed ? 3 : 2;
   if (a.picks.size() < min_picks)
@@ -334,7 +342,7 @@ int run_segment(const std::vector<std::string>& args) {
   json parameters = {{"step_height", o.step_height},
                      {"w_int", o.w_int},
                      {"open", !o.closed},
-                     {"relief_side", o.relief_side == rs::ReliefSide::Left ? "left" : "right"},
+                     {"relief_side", rs::to_string(result.relief_side)},
                      {"picks", a.picks},
                      {"max_iterations", o.max_iterations}};
   for (const rs::OptionInfo& option : rs::advanced_options())
@@ -349,6 +357,9 @@ int run_segment(const std::vector<std::string>& args) {
                     {"mesh", report_json(mesh, a.mesh_path)},
                     {"planarity_vertices", result.planarity_vertices},
                     {"notes", result.notes},
+                    {"message", result.message},
+                    {"reasons", result.reasons},
+                    {"checks", json(std::map<std::string, double>(result.checks.begin(), result.checks.end()))},
                     {"timing", {{"load_seconds", load_seconds}, {"segment_seconds", segment_seconds}}}};
   const std::string text = out.dump(2) + "\n";
   if (a.out_path.empty()) {
@@ -367,7 +378,9 @@ int run_segment(const std::vector<std::string>& args) {
                  rs::to_string(result.status), segment_seconds, result.polyline.size(), result.relief_vertices.size(),
                  a.out_path.empty() ? "" : "; wrote ", a.out_path.c_str());
   }
-  return 0;
+  if (!a.quiet && !result.message.empty()) std::fprintf(stderr, "relief-snake: %s\n", result.message.c_str());
+  // 3: a result was written, but the engine does not vouch for it (doubtful, iteration cap).
+  return result.status == rs::Status::Converged ? 0 : 3;
 }
 
 /// One line, whatever the message holds.

@@ -131,6 +131,10 @@ const std::vector<Row>& rows() {
       boolean("convex_barrier", &Options::convex_barrier,
               "also penalise P^(v) < P^(q) (experimental, not in the paper)"),
       boolean("remove_loops", &Options::remove_loops, "cut off loops where the snake crosses itself (not in the paper)"),
+      boolean("refit_step_height", &Options::refit_step_height,
+              "segment again with the step measured along the contour when it disagrees with h (not in the paper)"),
+      number("refit_ratio", &Options::refit_ratio, "> 1", [](double x) { return x > 1; },
+             "refit h when the step found and h differ by more than this factor"),
       boolean("foot_snap", &Options::foot_snap,
               "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
               "the background (not in the paper)"),

@@ -8,18 +8,31 @@
 
 #include "relief_snake/energy.hpp"
 #include "relief_snake/error.hpp"
+#include "relief_snake/evidence.hpp"
 #include "relief_snake/evolution.hpp"
 #include "relief_snake/foot.hpp"
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/planarity.hpp"
 #include "relief_snake/region.hpp"
+#include "relief_snake/schedule.hpp"
 #include "relief_snake/snake.hpp"
+#include "relief_snake/step_height.hpp"
 
 namespace relief_snake {
+
+const char* to_string(ReliefSide side) {
+  switch (side) {
+    case ReliefSide::Left: return "left";
+    case ReliefSide::Right: return "right";
+    case ReliefSide::Auto: return "auto";
+  }
+  return "unknown";
+}
 
 const char* to_string(Status status) {
   switch (status) {
     case Status::Converged: return "converged";
+    case Status::Doubtful: return "doubtful";
     case Status::IterationCap: return "iteration_cap";
     case Status::Cancelled: return "cancelled";
   }
@@ -31,7 +44,7 @@ std::vector<std::pair<const char*, double>> DerivedParameters::named_values() co
           {"beta_coarse", beta_coarse},       {"alpha_refine", alpha_refine},     {"beta_refine", beta_refine},
           {"gamma", gamma},                   {"sigma_background", sigma_background}, {"sigma_s", sigma_s},
           {"w_int", w_int},                   {"w_f", w_f},                       {"w_d", w_d},
-          {"average_edge", average_edge}};
+          {"average_edge", average_edge},    {"step_height", step_height}};
 }
 
 namespace {
@@ -50,13 +63,13 @@ std::string fmt(double x) {
 
 void validate_options(const Mesh& mesh, const Options& o) {
   const double h = o.step_height;
-  if (!std::isfinite(h) || h <= 0)
-    throw Error("step height h must be a positive number (got " + fmt(h) +
+  if (!std::isfinite(h) || h < 0)
+    throw Error("step height h must be a positive number, or auto (got " + fmt(h) +
                 "); measure the relief's step with the measure tool");
   if (h > mesh.bbox_diagonal())
     throw Error("step height h = " + fmt(h) + " is larger than the whole mesh (diagonal " +
                 fmt(mesh.bbox_diagonal()) + "); check the units of h");
-  if (!std::isfinite(o.w_int) || o.w_int <= 0 || o.w_int > 1)
+  if (!std::isfinite(o.w_int) || o.w_int < 0 || o.w_int > 1)
     throw Error("W_int must be in (0, 1] (got " + fmt(o.w_int) + "); try 0.25, then halve it if concavities are missed");
   if (!(o.tau > 0 && o.tau < 1)) throw Error("tau must be in (0, 1) (got " + fmt(o.tau) + ")");
   if (!(o.epsilon >= 0 && o.epsilon < 1)) throw Error("epsilon must be in [0, 1) (got " + fmt(o.epsilon) + ")");
@@ -67,6 +80,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
   if (o.refine_levels < 0 || o.refine_levels > 16) throw Error("refine_levels must be between 0 and 16 (1: the paper's)");
   if (o.max_iterations < 1) throw Error("max_iterations must be at least 1 (got " + std::to_string(o.max_iterations) + ")");
   if (o.threads < 0) throw Error("threads must be 0 (all cores) or a positive count (got " + std::to_string(o.threads) + ")");
+  if (!(o.refit_ratio > 1) || !std::isfinite(o.refit_ratio)) throw Error("refit_ratio must be a number > 1");
   if (!(o.feature_contrast > 0) || !std::isfinite(o.feature_contrast))
     throw Error("feature_contrast must be a positive number");
 }
@@ -120,20 +134,70 @@ struct Segmenter::Cache {
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
 Segmenter::~Segmenter() = default;
 
+namespace {
+
+// One refinement tried: the contour, its region and the evidence for it.
+struct Attempt {
+  double h = 0, w_int = 0;
+  ScheduleRun run;
+  std::vector<char> region;
+  StepEvidence evidence;
+  double coarse_iou = 1;
+  SelfCheck check;
+  DerivedParameters parameters;
+  std::vector<std::string> notes;
+  bool usable() const { return !run.cancelled && !run.collapsed && !run.contour.empty(); }
+};
+
+// a is better evidence than b.
+bool better(const Attempt& a, const Attempt& b) {
+  if (a.usable() != b.usable()) return a.usable();
+  if (a.check.holds != b.check.holds) return a.check.holds;
+  if (a.check.holds) {  // both hold: the one whose step agrees with its own h
+    const double ra = std::fabs(std::log(a.evidence.step_height / a.h));
+    const double rb = std::fabs(std::log(b.evidence.step_height / b.h));
+    if (std::fabs(ra - rb) > 0.1) return ra < rb;
+  }
+  return a.check.score > b.check.score;
+}
+
+}  // namespace
+
+// The planarity field for h, reused while h and the planarity options stay the same.
+static PlanarityField& planarity_for(const Mesh& mesh, std::unique_ptr<PlanarityField>& field,
+                                     PlanarityOptions& was, std::shared_ptr<const MomentTree>& tree_cache,
+                                     const Options& options, double h, const std::vector<SurfacePoint>& start,
+                                     int component) {
+  PlanarityOptions po;
+  po.radius = h;
+  po.threads = options.threads;
+  po.neighbourhood = options.neighbourhood;
+  po.fit = options.plane_fit;
+  po.include_one_ring = options.planarity_one_ring;
+  if (!field || was.radius != h || was.neighbourhood != po.neighbourhood || was.fit != po.fit ||
+      was.include_one_ring != po.include_one_ring) {
+    std::shared_ptr<const MomentTree> tree;
+    if (tree_cache && tree_cache->elements() == PlanarityField::tree_elements(po.fit)) tree = tree_cache;
+    field = std::make_unique<PlanarityField>(mesh, po, tree);
+    if (field->tree()) tree_cache = field->tree();
+    field->estimate_sigma_s(planarity_sample(mesh, start, component));
+    was = po;
+  }
+  return *field;
+}
+
 Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options& options,
                           const ProgressCallback& progress) {
   const auto t_start = Clock::now();
   const Mesh& mesh = mesh_;
   validate_options(mesh, options);
   const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
-  const double h = options.step_height;
+  const int component = mesh.component(pick_vertices.front());
 
   Result result;
   result.closed = options.closed;
-  DerivedParameters& param = result.parameters;
-  param.average_edge = mesh.average_edge_length();
 
-  // --- initial contour (Section 7.1), sampled at l = h ----------------------
+  // --- initial contour (Section 7.1) -----------------------------------------
   InitialContour initial = initial_contour(mesh, pick_vertices, options.closed);
   if (initial.fallback_legs > 0)
     result.notes.push_back(std::to_string(initial.fallback_legs) +
@@ -146,189 +210,204 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     if (initial.path.size() != before)
       result.notes.push_back("the open contour's ends were extended to the mesh boundary");
   }
-  std::vector<SurfacePoint> start = resample_path(mesh, initial.path, h, options.closed);
-  if (static_cast<int>(start.size()) < (options.closed ? 4 : 3))
-    throw Error("the picked contour is only " + std::to_string(start.size()) +
-                " step heights long; pick vertices further from the relief or check h");
-  const bool inside_left = options.closed ? contour_orientation_left(mesh, start)
-                                          : options.relief_side == ReliefSide::Left;
 
-  // --- planarity (Sections 5.3, 7.2.1), reused between calls for the same h --
-  PlanarityOptions po;
-  po.radius = h;
-  po.threads = options.threads;
-  po.neighbourhood = options.neighbourhood;
-  po.fit = options.plane_fit;
-  po.include_one_ring = options.planarity_one_ring;
-  const PlanarityOptions& was = cache_->options;
-  if (!cache_->planarity || was.radius != h || was.neighbourhood != po.neighbourhood || was.fit != po.fit ||
-      was.include_one_ring != po.include_one_ring) {
-    std::shared_ptr<const MomentTree> tree;
-    if (cache_->tree && cache_->tree->elements() == PlanarityField::tree_elements(po.fit)) tree = cache_->tree;
-    cache_->planarity = std::make_unique<PlanarityField>(mesh, po, tree);
-    if (cache_->planarity->tree()) cache_->tree = cache_->planarity->tree();
-    cache_->planarity->estimate_sigma_s(planarity_sample(mesh, start, mesh.component(pick_vertices.front())));
-    cache_->options = po;
-  }
-  PlanarityField& planarity = *cache_->planarity;
-  param.sigma_s = planarity.sigma_s();
-  {
-    // sigma of Eqn. 9: spread of P^ along the initial contour, on the background.
-    std::vector<int> corners;
-    for (const SurfacePoint& p : start)
-      for (int k = 0; k < 3; ++k) corners.push_back(mesh.face_vertex(p.face, k));
-    planarity.prefetch_filtered(corners);  // one parallel batch
-    double sum = 0, sum2 = 0;
-    for (const SurfacePoint& p : start) {
-      const double v = planarity.filtered(p);
-      sum += v;
-      sum2 += v * v;
+  // --- step height and relief side --------------------------------------------
+  const bool h_given = options.step_height > 0;
+  const bool side_given = options.closed || options.relief_side != ReliefSide::Auto;
+  bool inside_left = options.closed ? contour_orientation_left(mesh, initial.path)
+                                    : options.relief_side != ReliefSide::Right;
+  double h = options.step_height;
+  if (!h_given || !side_given) {
+    const StepHeightEstimate estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left);
+    if (!side_given) {
+      inside_left = estimate.relief_left;
+      result.notes.push_back(std::string("the relief side was decided from the surface: ") +
+                             (inside_left ? "left" : "right") + " of the picks (the side that rises)");
     }
-    const double n = static_cast<double>(start.size());
-    param.sigma_background = std::sqrt(std::max(0.0, sum2 / n - (sum / n) * (sum / n)));
+    if (!h_given) {
+      if (!(estimate.value > 0))
+        throw Error("could not estimate the step height: nothing rises above the background inside the picked "
+                    "contour; give h (measure the step) or pick around the relief");
+      h = estimate.value;
+      if (h > mesh.bbox_diagonal()) h = mesh.bbox_diagonal() / 4;
+      result.step_height_estimate = h;
+      result.step_height_confidence = estimate.confidence;
+    }
   }
-  const double preprocess_seconds = seconds_since(t_start);
+  result.relief_side = inside_left ? ReliefSide::Left : ReliefSide::Right;
 
-  // --- parameters (Section 7.2) ---------------------------------------------
-  param.coarse_spacing = h;
-  param.refine_spacing = 0.5 * mesh.average_edge_length();
-  param.alpha_coarse = normalise_alpha(param.coarse_spacing);
-  param.beta_coarse = normalise_beta(param.coarse_spacing, options.max_turn_degrees);
-  param.alpha_refine = normalise_alpha(param.refine_spacing);
-  param.beta_refine = normalise_beta(param.refine_spacing, options.max_turn_degrees);
-  // gamma normalises E_f so a step of planarity contrast feature_contrast * h
-  // scores -1 at l = h; like alpha it scales with 1/l between phases (7.2.3).
-  const double contrast = options.feature_contrast * h;
-  param.gamma = 1.0 / (contrast * contrast);
-  param.w_int = options.w_int;
-  param.w_f = 1;
-  param.w_d = 4 - 2 * options.w_int - param.w_f;
-
-  Snake snake(mesh, start, options.closed, inside_left);
-  snake.set_nearest_resampling(options.nearest_resampling);
-  FeatureEnergy feature(planarity, h, options.epsilon, options.q_samples, options.exact_q);
-  feature.set_convex_barrier(options.convex_barrier);
-
-  PhaseSettings base;
-  base.tau = options.tau;
-  base.max_turn_degrees = options.max_turn_degrees;
-  base.lock_interval = options.lock_interval;
-  base.max_iterations = options.max_iterations;
-  base.min_snaxels = options.closed ? 4 : 2;
-  base.remove_loops = options.remove_loops;
-
-  PhaseSettings coarse = base;
-  coarse.name = "coarse";
-  coarse.l = param.coarse_spacing;
-  coarse.alpha = param.alpha_coarse;
-  coarse.beta = param.beta_coarse;
-  coarse.gamma = param.gamma;
-  coarse.w_int = coarse.w_f = coarse.w_d = 1;
-  coarse.gamma_sigma2 = param.gamma * param.sigma_background * param.sigma_background;
-
-  // A refinement setting at spacing l: alpha and beta normalised for l, gamma scaled with 1/l.
-  auto at_spacing = [&](PhaseSettings settings, double l) {
-    settings.l = l;
-    settings.alpha = normalise_alpha(l);
-    settings.beta = normalise_beta(l, options.max_turn_degrees);
-    settings.gamma = options.scale_feature_with_spacing ? param.gamma * coarse.l / l : param.gamma;
-    return settings;
+  // --- attempts: schedule -> foot -> region -> self-check, for each h and W_int tried
+  const std::vector<double> w_steps =
+      options.w_int > 0 ? std::vector<double>{options.w_int} : std::vector<double>{0.25, 0.5, 1.0};
+  double preprocess_seconds = 0;
+  bool cancelled = false;
+  std::string collapse_phase;
+  auto attempt_at = [&](double h_try) {
+    Attempt best;
+    best.h = h_try;
+    const auto t_pre = Clock::now();
+    std::vector<SurfacePoint> start = resample_path(mesh, initial.path, h_try, options.closed);
+    if (static_cast<int>(start.size()) < (options.closed ? 4 : 3)) {
+      best.run.collapsed = true;
+      collapse_phase = "initial";
+      return best;
+    }
+    PlanarityField& planarity = planarity_for(mesh, cache_->planarity, cache_->options, cache_->tree, options,
+                                              h_try, start, component);
+    EvolutionSchedule schedule(mesh, planarity, options, h_try, start, inside_left);
+    preprocess_seconds += seconds_since(t_pre);
+    const ScheduleRun& coarse = schedule.coarse(progress);
+    if (coarse.cancelled) {
+      cancelled = true;
+      return best;
+    }
+    if (coarse.collapsed) {
+      best.run = coarse;
+      collapse_phase = "coarse";
+      return best;
+    }
+    const std::vector<char> coarse_region = relief_region(mesh, coarse.contour, options.closed, inside_left);
+    bool first = true;
+    for (const double w : w_steps) {
+      Attempt a;
+      a.h = h_try;
+      a.w_int = w;
+      a.run = schedule.refine(w, progress);
+      a.parameters = schedule.parameters(w);
+      ++result.attempts;
+      if (a.run.cancelled) {
+        cancelled = true;
+        return best;
+      }
+      if (a.run.collapsed) {
+        collapse_phase = a.run.collapsed_phase;
+        if (first) best = a, first = false;
+        continue;
+      }
+      if (options.foot_snap) {
+        Snake& snake = *a.run.snake;
+        FootOptions fo;
+        fo.h = h_try;
+        const FootResult foot = settle_at_foot(&snake, fo);
+        // Moving out can twist neighbours (rays from a jagged snake cross): cut the loops
+        // (each call removes at most 64) and the sharp turns again.
+        for (int guard = 0; guard < 100 && snake.remove_loops() > 0; ++guard) {
+        }
+        snake.remove_sharp_turns(options.max_turn_degrees);
+        if (foot.noisy)
+          a.notes.push_back("not settled at the foot: the background is too noisy (residual " +
+                            fmt(foot.background_residual / h_try) + " h)");
+        else
+          a.notes.push_back("settled at the foot: " + std::to_string(foot.moved) + " snaxels moved out by " +
+                            fmt(foot.mean_move / h_try) + " h on average, " + std::to_string(foot.skipped) +
+                            " left (no clean background outside)");
+        a.run.contour = snake.points();
+      }
+      a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
+      a.evidence = measure_step(mesh, a.run.contour, a.region, h_try);
+      a.coarse_iou = region_iou(mesh, coarse_region, a.region);
+      a.check = judge(a.evidence, a.coarse_iou, h_try);
+      const bool holds = a.check.holds;
+      if (first || better(a, best)) best = std::move(a);
+      first = false;
+      if (holds) break;
+    }
+    return best;
   };
-  PhaseSettings refine = base;
-  refine.name = "refine";
-  refine.w_int = param.w_int;
-  refine.w_f = param.w_f;
-  refine.w_d = param.w_d;
-  refine.gamma_sigma2 = 0;
-  refine = at_spacing(refine, param.refine_spacing);
 
-  PhaseSettings stabilise = refine;
-  stabilise.name = "stabilise";
-  stabilise.w_int = 1;
-  stabilise.w_d = 0;
+  Attempt best = attempt_at(h);
+  std::vector<double> tried = {h};
+  for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
+    const double found = best.evidence.step_height;
+    if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
+    bool near_tried = false;
+    for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
+    if (near_tried) break;
+    tried.push_back(found);
+    Attempt next = attempt_at(found);
+    if (cancelled) break;
+    if (better(next, best)) {
+      result.notes.push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(best.h) +
+                             "; segmented again with h = " + fmt(found));
+      best = std::move(next);
+    } else {
+      break;
+    }
+  }
+  if (cancelled) {
+    Result out;
+    out.status = Status::Cancelled;
+    out.closed = options.closed;
+    return out;
+  }
+  if (!best.usable()) {
+    if (collapse_phase == "initial")
+      throw Error("the picked contour is only a few step heights long; pick vertices further from the relief "
+                  "or check h (" + fmt(h) + ")");
+    throw Error("the snake collapsed during the " + collapse_phase +
+                " phase without meeting a relief step; check that h (" + fmt(h) +
+                ") matches the relief's step height and that the picks surround the relief");
+  }
 
+  // --- the result ---------------------------------------------------------------
+  DerivedParameters& param = result.parameters;
   PhaseStats pre;
   pre.name = "preprocess";
   pre.seconds = preprocess_seconds;
-  pre.snaxels = snake.size();
+  pre.snaxels = best.run.phases.empty() ? 0 : best.run.phases.front().snaxels;
   result.phases.push_back(pre);
-
-  // The refinement's spacings: the paper goes straight to half an edge; with
-  // refine_levels != 1 the snake is refined coarse to fine, from h / 2 down to half an
-  // edge in equal ratios of at most 2 (fewer levels if refine_levels says so), each
-  // level run to convergence: the long moves into deep concavities happen at the
-  // coarse levels, in few iterations of few snaxels.
-  std::vector<double> refine_spacings = {refine.l};
-  if (options.refine_levels != 1 && 0.5 * h > refine.l * 1.05) {
-    const double span = 0.5 * h / refine.l;
-    int levels = static_cast<int>(std::ceil(std::log2(span))) + 1;
-    if (options.refine_levels > 1) levels = std::min(levels, options.refine_levels);
-    refine_spacings.clear();
-    for (int k = levels - 1; k >= 0; --k) refine_spacings.push_back(refine.l * std::pow(span, k / double(levels - 1)));
+  for (const PhaseStats& p : best.run.phases) result.phases.push_back(p);
+  if (best.run.refine_levels > 1)
+    result.notes.push_back("refined coarse to fine in " + std::to_string(best.run.refine_levels) + " levels");
+  for (const std::string& n : best.notes) result.notes.push_back(n);
+  if (options.w_int <= 0 && best.w_int != w_steps.front())
+    result.notes.push_back("W_int " + fmt(best.w_int) + " chosen: the self-check failed with smaller values");
+  param = best.parameters;
+  result.planarity_vertices = cache_->planarity ? cache_->planarity->raw_count() : 0;
+  param.step_height = best.h;
+  if (!h_given && std::fabs(std::log(best.h / h)) > 1e-12) {
+    // Refitted from the contour: as sure as the step found along it is even.
+    result.step_height_confidence = std::clamp(1.0 - best.evidence.step_spread, 0.0, 1.0) * best.evidence.step_share;
+  } else if (!h_given) {
+    result.step_height_confidence =
+        std::max(result.step_height_confidence,
+                 std::clamp(1.0 - best.evidence.step_spread, 0.0, 1.0) * best.evidence.step_share);
   }
 
-  bool hit_cap = false;
-  for (PhaseSettings* phase : {&coarse, &refine, &stabilise}) {
-    const auto t_phase = Clock::now();
-    const std::vector<double> spacings = phase == &refine ? refine_spacings : std::vector<double>{phase->l};
-    PhaseStats stats;
-    stats.name = phase->name;
-    for (const double l : spacings) {
-      const PhaseSettings settings = phase == &refine ? at_spacing(refine, l) : *phase;
-      if (phase == &refine) snake.subdivide(l);
-      snake.reset_state();
-      const PhaseOutcome outcome = run_phase(snake, feature, settings, progress, planarity.pool());
-      if (outcome.cancelled) {
-        Result cancelled;
-        cancelled.status = Status::Cancelled;
-        cancelled.closed = options.closed;
-        return cancelled;
-      }
-      if (outcome.collapsed || (options.closed && phase == &coarse && snake.length() < 2 * h))
-        throw Error("the snake collapsed during the " + std::string(phase->name) +
-                    " phase without meeting a relief step; check that h (" + fmt(h) +
-                    ") matches the relief's step height and that the picks surround the relief");
-      stats.iterations += outcome.iterations;
-      stats.converged = stats.converged && outcome.converged;
-    }
-    stats.snaxels = snake.size();
-    stats.seconds = seconds_since(t_phase);
-    hit_cap = hit_cap || !stats.converged;
-    result.phases.push_back(stats);
-  }
-  if (refine_spacings.size() > 1)
-    result.notes.push_back("refined coarse to fine in " + std::to_string(refine_spacings.size()) + " levels (" +
-                           fmt(refine_spacings.front() / h) + " h down to " + fmt(refine_spacings.back() / h) + " h)");
-
-  if (options.foot_snap) {
-    FootOptions fo;
-    fo.h = h;
-    const FootResult foot = settle_at_foot(&snake, fo);
-    // Moving out can twist neighbours (rays from a jagged snake cross): cut the loops
-    // (each call removes at most 64) and the sharp turns again.
-    for (int guard = 0; guard < 100 && snake.remove_loops() > 0; ++guard) {
-    }
-    snake.remove_sharp_turns(options.max_turn_degrees);
-    if (foot.noisy)
-      result.notes.push_back("not settled at the foot: the background is too noisy (residual " +
-                             fmt(foot.background_residual / h) + " h)");
-    else
-      result.notes.push_back("settled at the foot: " + std::to_string(foot.moved) + " snaxels moved out by " +
-                             fmt(foot.mean_move / h) + " h on average, " + std::to_string(foot.skipped) +
-                             " left (no clean background outside)");
-  }
-
-  result.status = hit_cap ? Status::IterationCap : Status::Converged;
-  result.contour = snake.points();
-  result.polyline = snake.polyline();
-
-  // --- the relief region ----------------------------------------------------
-  const std::vector<char> inside = relief_region(mesh, result.contour, options.closed, inside_left);
+  result.contour = best.run.contour;
+  result.polyline.reserve(result.contour.size());
+  for (const SurfacePoint& p : result.contour) result.polyline.push_back(position(mesh, p));
   for (std::size_t i = 0; i < mesh.input_vertex_count(); ++i) {
     const int v = mesh.input_to_mesh(i);
-    if (v >= 0 && inside[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
+    if (v >= 0 && best.region[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
   }
-  result.planarity_vertices = planarity.raw_count();
+
+  result.checks = {{"step_share", best.evidence.step_share},
+                   {"step_height", best.evidence.step_height},
+                   {"rise_median", best.evidence.rise_median},
+                   {"step_spread", best.evidence.step_spread},
+                   {"background_residual", best.evidence.background_residual},
+                   {"measured_share", best.evidence.measured_share()},
+                   {"coarse_iou", best.coarse_iou},
+                   {"region_area", region_area(mesh, best.region)}};
+  result.reasons = best.check.reasons;
+  if (best.run.hit_cap) {
+    result.status = Status::IterationCap;
+    result.reasons.insert(result.reasons.begin(), "a phase stopped at the iteration cap (" +
+                                                      std::to_string(options.max_iterations) +
+                                                      ") before the snake settled");
+  } else {
+    result.status = best.check.holds ? Status::Converged : Status::Doubtful;
+  }
+  if (result.status != Status::Converged) {
+    std::string message = result.status == Status::IterationCap ? "The snake did not settle: " : "Check this result: ";
+    for (std::size_t k = 0; k < result.reasons.size(); ++k) message += (k ? "; " : "") + result.reasons[k];
+    message += ". Try picks closer around the relief";
+    if (h_given) message += ", or a different step height";
+    message += ".";
+    result.message = message;
+  }
+  result.checks.push_back({"seconds", seconds_since(t_start)});
   return result;
 }
 

@@ -1,6 +1,7 @@
 #include "relief_snake/surface_point.hpp"
 
 #include <algorithm>
+#include <unordered_set>
 #include <cmath>
 #include <limits>
 
@@ -316,7 +317,21 @@ SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, con
   double best_d2 = (position(mesh, start) - target).squaredNorm();
   const double r2 = radius * radius;
   // Breadth-first over faces sharing a corner, through faces that come within
-  // `radius` of the target; the visited list doubles as the queue (it stays small).
+  // `radius` of the target; the visited list doubles as the queue. It is usually
+  // small, and searched linearly; past kLinear faces (a radius of many edges: a
+  // coarse snake on a fine mesh) membership goes through a hash set instead, so the
+  // search stays linear in the faces it visits.
+  constexpr std::size_t kLinear = 48;
+  std::unordered_set<int> member;
+  auto seen = [&](int g) {
+    if (visited.size() <= kLinear) return std::find(visited.begin(), visited.end(), g) != visited.end();
+    if (member.empty()) member.insert(visited.begin(), visited.end());
+    return member.count(g) != 0;
+  };
+  auto add = [&](int g) {
+    visited.push_back(g);
+    if (!member.empty()) member.insert(g);
+  };
   visited.push_back(start.face);
   for (std::size_t k = 0; k < visited.size(); ++k) {
     const int f = visited[k];
@@ -332,7 +347,7 @@ SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, con
     for (int j = 0; j < 3; ++j) {
       const int v = mesh.face_vertex(f, j);
       for (const int* g = mesh.faces_begin(v); g != mesh.faces_end(v); ++g)
-        if (std::find(visited.begin(), visited.end(), *g) == visited.end()) visited.push_back(*g);
+        if (!seen(*g)) add(*g);
     }
     if (visited.size() > 4096) break;  // a guard for absurd radii; the search is meant to be local
   }

@@ -80,7 +80,8 @@ TEST(SegmentErrors, BadStepHeight) {
 
 TEST(SegmentErrors, WIntOutsideZeroOne) {
   const Mesh mesh = two_planes();
-  for (double w : {0.0, -0.25, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+  // 0 is kAuto (the engine chooses); everything else outside (0, 1] is refused.
+  for (double w : {-0.25, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
     Options o = with_h(0.5);
     o.w_int = w;
     EXPECT_NE(error_of(mesh, kRing, o).find("W_int"), std::string::npos) << w;

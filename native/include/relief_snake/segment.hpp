@@ -14,14 +14,29 @@
 
 namespace relief_snake {
 
-enum class ReliefSide { Left, Right };
+/// Open contours: the relief's side seen from outside along the pick order; Auto: the side that rises.
+enum class ReliefSide { Left, Right, Auto };
+const char* to_string(ReliefSide side);
 
-/// Parameters of a segmentation. Defaults are the paper's (Section 7.2).
+/// Options::step_height and Options::w_int: let the engine choose.
+constexpr double kAuto = 0.0;
+
+/// Parameters of a segmentation. The method's constants are the paper's (Section 7.2);
+/// h, W_int and the relief side are chosen by the engine unless given.
 struct Options {
-  double step_height = 0;          ///< h, the relief's step height (required, > 0)
-  double w_int = 0.25;             ///< W_int for refinement, in (0, 1]
+  /// h, the relief's step height (> 0), or kAuto: estimated from the picks and the surface
+  /// (step_height.hpp), then refitted from the step found along the contour.
+  double step_height = kAuto;
+  /// W_int for refinement, in (0, 1], or kAuto: refinement runs at w_int_steps in turn until the
+  /// self-check holds, keeping the best evidence (the paper's value, 0.25, comes first).
+  double w_int = kAuto;
   bool closed = true;              ///< closed contour around the relief, or open (ends on the mesh boundary)
-  ReliefSide relief_side = ReliefSide::Left;  ///< open contours: side of the relief, seen from outside along the pick order
+  ReliefSide relief_side = ReliefSide::Auto;  ///< open contours only
+  /// When the step found along the contour disagrees with h by more than refit_ratio, segment
+  /// again with the step found (at most twice) and keep the better evidence. Applies to a given
+  /// h too: a rough h is the common case (not in the paper).
+  bool refit_step_height = true;
+  double refit_ratio = 1.3;
 
   // Fixed by the paper; exposed for experiments and the benchmark.
   double tau = 0.2;                ///< movement step, fraction of the local segment length
@@ -59,7 +74,8 @@ struct Options {
 };
 
 enum class Status {
-  Converged,      ///< every phase stopped because nothing moved any more
+  Converged,      ///< every phase stopped because nothing moved any more, and the self-check holds (evidence.hpp)
+  Doubtful,       ///< the snake settled, but the self-check found it may not be on the relief's step
   IterationCap,   ///< at least one phase hit Options::max_iterations
   Cancelled,      ///< the progress callback asked to stop; the result holds nothing
 };
@@ -75,6 +91,7 @@ struct PhaseStats {
 
 /// Parameters derived from the mesh and options (Section 7.2), for reports.
 struct DerivedParameters {
+  double step_height = 0;       ///< h used (given, estimated or refitted)
   double coarse_spacing = 0, refine_spacing = 0;  ///< l in each phase
   double alpha_coarse = 0, beta_coarse = 0, alpha_refine = 0, beta_refine = 0, gamma = 0;
   double sigma_background = 0;  ///< std. dev. of P^ along the initial contour (Eqn. 9)
@@ -91,10 +108,21 @@ struct Result {
   std::vector<SurfacePoint> contour;     ///< final snaxels, in order
   std::vector<Vec3> polyline;            ///< their 3D positions
   std::vector<std::int64_t> relief_vertices;  ///< input vertex indices inside the contour (or on the relief side)
+  ReliefSide relief_side = ReliefSide::Left;  ///< open contours: the side used (given or decided)
   std::vector<PhaseStats> phases;
   DerivedParameters parameters;
   std::size_t planarity_vertices = 0;    ///< vertices whose planarity was computed
   std::vector<std::string> notes;        ///< non-fatal remarks (e.g. open-contour ends extended to the boundary)
+  /// Plain words for the status: empty when converged, else what is wrong and what to try.
+  std::string message;
+  std::vector<std::string> reasons;      ///< each failed self-check, one sentence each
+  /// The self-check's measurements by name (step_share, step_height, coarse_iou, ...).
+  std::vector<std::pair<std::string, double>> checks;
+  /// When h was not given: the first estimate from the picks (0 otherwise), and how sure
+  /// the engine is of the h it used in the end (0..1; 1 when given).
+  double step_height_estimate = 0;
+  double step_height_confidence = 1;
+  int attempts = 0;                      ///< refinement runs tried (W_int and h choices)
 };
 
 /// What the progress callback sees (valid only during the call).

@@ -1,0 +1,86 @@
+#pragma once
+// Step evidence: does a contour sit on a relief step? The self-check of a
+// segmentation (not in the paper). A snake can settle anywhere its energy has a
+// minimum: on the step, but also on interior detail, on the relief's flat top after
+// deflation carried it across the step, or on background texture. None of these
+// looks different to the snake, but all of them look different in the heights:
+// on a true step the surface just inside the contour stands clearly above the
+// background just outside it.
+//
+// For a sample of the contour's points, the background outside is fitted by a
+// local plane (vertices outside the region, in a ball around the point), and the
+// heights of the region's vertices in the same ball are measured above it. The
+// point sits on a step when those heights rise clearly above the plane, by a
+// fraction of h and by several times the background's own residual.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "relief_snake/mesh.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+struct EvidenceOptions {
+  double radius = 2.5;          ///< ball around a contour point, in units of h ...
+  double min_radius_edges = 6;  ///< ... and at least this many average edges (coarse meshes, small h)
+  double outside_from = 0.5;    ///< outside vertices closer than this (in h, at least one average edge) to the
+                                ///< point are left out of the fit
+  double rise_quantile = 0.75;  ///< the rise of a profile: this quantile of the inside heights
+  double min_rise = 0.3;        ///< a profile is on a step if its rise exceeds min_rise h ...
+  double residual_factor = 3;   ///< ... and residual_factor times the outside fit's RMS residual
+  int max_profiles = 240;       ///< contour points measured (evenly spread)
+  int min_side_vertices = 6;    ///< fewer inside or outside vertices in the ball: not measured
+};
+
+/// One measured contour point.
+struct StepProfile {
+  int contour_index = -1;
+  double rise = 0;      ///< the inside's height above the outside plane (rise_quantile of the heights)
+  double residual = 0;  ///< RMS residual of the outside plane fit
+  bool on_step = false;
+};
+
+struct StepEvidence {
+  std::vector<StepProfile> profiles;  ///< the measured points (those with enough vertices on both sides)
+  int attempted = 0;                  ///< contour points looked at
+  double step_share = 0;              ///< share of measured profiles on a step (0 if none measured)
+  double step_height = 0;             ///< median rise of the profiles on a step: the step height found
+  double rise_median = 0;             ///< median rise of all measured profiles
+  double step_spread = 0;             ///< (q75 - q25) / median of the on-step rises: how even the step is
+  double background_residual = 0;     ///< median RMS residual of the outside fits
+  double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
+};
+
+/// Measures the step along a contour (snaxels in order).
+/// region: #V flags (mesh vertices, 1 = relief side), as relief_region() returns.
+/// h: the step height the segmentation used (sets the ball and the rise threshold).
+StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& contour,
+                          const std::vector<char>& region, double h, const EvidenceOptions& options = {});
+
+/// Thresholds of the self-check: when a segmentation's evidence is good enough to call
+/// it converged. Chosen on the benchmark's randomized suite (bench/, docs/design.md).
+struct SelfCheckOptions {
+  double min_step_share = 0.9;    ///< share of the measured contour that must sit on a step
+  double min_measured_share = 0.3;  ///< below this the step could not be checked at all
+  double min_coarse_iou = 0.6;    ///< overlap of the final region with the coarse phase's
+  double max_step_ratio = 2.0;    ///< the step found and h may differ by at most this factor
+};
+
+/// The verdict on one contour.
+struct SelfCheck {
+  bool holds = false;                ///< every check passed
+  double score = 0;                  ///< higher is better evidence (for choosing between attempts)
+  std::vector<std::string> reasons;  ///< one plain sentence per failed check
+};
+
+/// Judges a contour's evidence. coarse_iou: area IoU of the final region with the coarse
+/// contour's (1 if there is none); h: the step height used.
+SelfCheck judge(const StepEvidence& evidence, double coarse_iou, double h, const SelfCheckOptions& options = {});
+
+/// Area (sum of vertex areas) of the flagged vertices.
+double region_area(const Mesh& mesh, const std::vector<char>& region);
+/// Area-weighted intersection over union of two vertex flag sets (1 when both are empty).
+double region_iou(const Mesh& mesh, const std::vector<char>& a, const std::vector<char>& b);
+
+}  // namespace relief_snake

@@ -1,0 +1,60 @@
+#pragma once
+// The evolution schedule (Sections 6, 7.2): the coarse phase at l = h, the
+// refinement at half an edge (optionally coarse to fine) with W_int's weights,
+// and the stabilisation. A solver object: it runs the coarse phase once and then
+// any number of refinements from the coarse snake, so W_int can be chosen by
+// trying several (segment.hpp) without repeating the coarse phase.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "relief_snake/planarity.hpp"
+#include "relief_snake/segment.hpp"
+#include "relief_snake/snake.hpp"
+#include "relief_snake/surface_point.hpp"
+
+namespace relief_snake {
+
+/// Where a schedule run ended.
+struct ScheduleRun {
+  std::vector<SurfacePoint> contour;   ///< snaxels at the end, in order
+  std::shared_ptr<Snake> snake;        ///< the snake at the end (the foot stage moves it further)
+  std::vector<PhaseStats> phases;      ///< the phases that ran (coarse; refine, stabilise)
+  bool hit_cap = false;                ///< a phase stopped at Options::max_iterations
+  bool cancelled = false;              ///< the progress callback asked to stop
+  bool collapsed = false;              ///< the snake collapsed (collapsed_phase says where)
+  std::string collapsed_phase;
+  int refine_levels = 1;               ///< refinement spacings used
+};
+
+class EvolutionSchedule {
+ public:
+  /// start: the initial contour resampled at l = h; inside_left: the relief side.
+  /// options: the segmentation's options (tau, epsilon, ... ; w_int is given per refinement).
+  /// The planarity field must have been built for radius h; it must outlive this object.
+  EvolutionSchedule(const Mesh& mesh, PlanarityField& planarity, const Options& options, double h,
+                    const std::vector<SurfacePoint>& start, bool inside_left);
+
+  /// The derived parameters for a W_int (Section 7.2.3), also the coarse phase's.
+  DerivedParameters parameters(double w_int) const;
+
+  /// The coarse phase (runs once; later calls return the same run).
+  const ScheduleRun& coarse(const ProgressCallback& progress);
+  /// Refinement and stabilisation with this W_int, from the coarse snake. Runs the
+  /// coarse phase first if needed. The returned phases include the coarse one.
+  ScheduleRun refine(double w_int, const ProgressCallback& progress);
+
+ private:
+  const Mesh& mesh_;
+  PlanarityField& planarity_;
+  Options options_;
+  double h_;
+  bool inside_left_;
+  std::vector<SurfacePoint> start_;
+  double sigma_background_ = 0;
+  bool coarse_done_ = false;
+  ScheduleRun coarse_run_;
+  std::unique_ptr<Snake> coarse_snake_;  // as the coarse phase left it
+};
+
+}  // namespace relief_snake

@@ -1,0 +1,41 @@
+#pragma once
+// Estimating the step height h (and, for open contours, the relief's side) from the
+// picks and the surface (not in the paper, which asks the user to measure h).
+//
+// The picks are on the background around the relief, so the surface along the
+// initial contour samples the background. A smooth background (a quadratic height
+// field over the contour's best-fitting plane) is fitted to it and continued under
+// the relief; the heights of the vertices the contour encloses above it fall into
+// two groups, background near zero and relief, split at Otsu's threshold. The
+// relief group's median height is the estimate. This is a first guess: segment()
+// measures the step along the contour it finds and refits h from that (evidence.hpp).
+#include <string>
+#include <vector>
+
+#include "relief_snake/initial_contour.hpp"
+#include "relief_snake/mesh.hpp"
+
+namespace relief_snake {
+
+struct StepHeightOptions {
+  int band_rings = 2;              ///< background samples: the path's faces' corners and this many rings around
+  int histogram_bins = 128;
+  double min_separation = 0.5;     ///< Otsu's between-class share of the variance below which the estimate is unsure
+};
+
+struct StepHeightEstimate {
+  double value = 0;         ///< the estimated h (0: no relief found inside)
+  double confidence = 0;    ///< 0..1: how clearly the heights split into background and relief
+  double background_residual = 0;  ///< RMS residual of the background fit along the contour
+  double relief_share = 0;  ///< share of the enclosed area that rises above the threshold
+  bool relief_left = true;  ///< open contours: the side that rises (closed: as given)
+  double left_rise = 0, right_rise = 0;  ///< open contours: the 90% height on each side
+};
+
+/// path: the initial contour (picks joined, open ones extended to the boundary).
+/// inside_left: closed contours' enclosed side (contour_orientation_left()); ignored for
+/// open contours, whose relief side is decided here (the side that rises).
+StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& path, bool closed, bool inside_left,
+                                        const StepHeightOptions& options = {});
+
+}  // namespace relief_snake

@@ -1,0 +1,175 @@
+// Step evidence along a contour: local background planes outside, heights inside.
+#include "relief_snake/evidence.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace relief_snake {
+namespace {
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(q * (values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+// Vertices of v0's component within `radius` of `centre`, reached through vertices
+// that are themselves within it (so the far side of a thin shell stays out).
+void gather_ball(const Mesh& mesh, int v0, const Vec3& centre, double radius, std::vector<int>* mark, int stamp,
+                 std::vector<int>* out) {
+  out->clear();
+  const double r2 = radius * radius;
+  (*mark)[v0] = stamp;
+  out->push_back(v0);
+  for (std::size_t head = 0; head < out->size(); ++head) {
+    const int v = (*out)[head];
+    for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w) {
+      if ((*mark)[*w] == stamp) continue;
+      (*mark)[*w] = stamp;
+      if ((mesh.position(*w) - centre).squaredNorm() <= r2) out->push_back(*w);
+    }
+  }
+}
+
+}  // namespace
+
+double region_area(const Mesh& mesh, const std::vector<char>& region) {
+  double area = 0;
+  for (int v = 0; v < mesh.n_vertices(); ++v)
+    if (region[v]) area += mesh.vertex_area(v);
+  return area;
+}
+
+double region_iou(const Mesh& mesh, const std::vector<char>& a, const std::vector<char>& b) {
+  double both = 0, either = 0;
+  for (int v = 0; v < mesh.n_vertices(); ++v) {
+    if (a[v] && b[v]) both += mesh.vertex_area(v);
+    if (a[v] || b[v]) either += mesh.vertex_area(v);
+  }
+  return either > 0 ? both / either : 1.0;
+}
+
+StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& contour,
+                          const std::vector<char>& region, double h, const EvidenceOptions& options) {
+  StepEvidence evidence;
+  if (contour.empty() || h <= 0) return evidence;
+  const int n = static_cast<int>(contour.size());
+  const int count = std::min(n, std::max(1, options.max_profiles));
+  const double edge = mesh.average_edge_length();
+  const double radius = std::max(options.radius * h, options.min_radius_edges * edge);
+  const double exclude = std::max(options.outside_from * h, edge);
+  const double exclude2 = exclude * exclude;
+
+  std::vector<int> mark(mesh.n_vertices(), -1), ball;
+  std::vector<double> heights;
+  std::vector<int> outside;
+  for (int k = 0; k < count; ++k) {
+    const int i = static_cast<int>((static_cast<long long>(k) * n) / count);
+    ++evidence.attempted;
+    const SurfacePoint& p = contour[i];
+    const Vec3 centre = position(mesh, p);
+    gather_ball(mesh, nearest_corner(mesh, p), centre, radius, &mark, k, &ball);
+
+    // The background plane: area-weighted least squares over the outside vertices.
+    outside.clear();
+    double weight = 0;
+    Vec3 mean = Vec3::Zero(), normal_sum = Vec3::Zero();
+    int inside_count = 0;
+    for (const int v : ball) {
+      if (region[v]) {
+        ++inside_count;
+        continue;
+      }
+      if ((mesh.position(v) - centre).squaredNorm() < exclude2) continue;
+      outside.push_back(v);
+      const double a = mesh.vertex_area(v);
+      weight += a;
+      mean += a * mesh.position(v);
+      normal_sum += a * mesh.vertex_normal(v);
+    }
+    if (inside_count < options.min_side_vertices || static_cast<int>(outside.size()) < options.min_side_vertices ||
+        weight <= 0)
+      continue;
+    mean /= weight;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const int v : outside) {
+      const Vec3 d = mesh.position(v) - mean;
+      cov += mesh.vertex_area(v) * d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    Vec3 normal = solver.eigenvectors().col(0);
+    if (normal.dot(normal_sum) < 0) normal = -normal;
+    const double residual = std::sqrt(std::max(0.0, solver.eigenvalues()[0]) / weight);
+
+    heights.clear();
+    for (const int v : ball)
+      if (region[v]) heights.push_back((mesh.position(v) - mean).dot(normal));
+    StepProfile profile;
+    profile.contour_index = i;
+    profile.rise = quantile(heights, options.rise_quantile);
+    profile.residual = residual;
+    profile.on_step = profile.rise > std::max(options.min_rise * h, options.residual_factor * residual);
+    evidence.profiles.push_back(profile);
+  }
+
+  if (evidence.profiles.empty()) return evidence;
+  std::vector<double> rises, step_rises, residuals;
+  for (const StepProfile& p : evidence.profiles) {
+    rises.push_back(p.rise);
+    residuals.push_back(p.residual);
+    if (p.on_step) step_rises.push_back(p.rise);
+  }
+  evidence.step_share = double(step_rises.size()) / evidence.profiles.size();
+  evidence.rise_median = quantile(rises, 0.5);
+  evidence.background_residual = quantile(residuals, 0.5);
+  if (!step_rises.empty()) {
+    evidence.step_height = quantile(step_rises, 0.5);
+    if (evidence.step_height > 0)
+      evidence.step_spread = (quantile(step_rises, 0.75) - quantile(step_rises, 0.25)) / evidence.step_height;
+  }
+  return evidence;
+}
+
+}  // namespace relief_snake
+
+namespace relief_snake {
+namespace {
+std::string percent(double share) { return std::to_string(static_cast<int>(std::lround(100 * share))) + "%"; }
+std::string number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", x);
+  return buffer;
+}
+}  // namespace
+
+SelfCheck judge(const StepEvidence& evidence, double coarse_iou, double h, const SelfCheckOptions& options) {
+  SelfCheck check;
+  const double measured = evidence.measured_share();
+  if (measured < options.min_measured_share)
+    check.reasons.push_back("the step could be measured along only " + percent(measured) +
+                            " of the contour (too little surface on one side)");
+  else if (evidence.step_share < options.min_step_share)
+    check.reasons.push_back("only " + percent(evidence.step_share) +
+                            " of the contour runs along a step: it may have crossed into the relief or stopped "
+                            "on detail or texture");
+  if (coarse_iou < options.min_coarse_iou)
+    check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(coarse_iou) +
+                            ": refinement moved far from where the step was first found");
+  if (evidence.step_height > 0 &&
+      (evidence.step_height > options.max_step_ratio * h || evidence.step_height * options.max_step_ratio < h))
+    check.reasons.push_back("the step along the contour is " + number(evidence.step_height) +
+                            " high, far from the step height used (" + number(h) + ")");
+  check.holds = check.reasons.empty();
+  // Prefer evidence that holds; then more of the contour on a step, a region that agrees
+  // with the coarse phase, and a step that agrees with h.
+  const double ratio = evidence.step_height > 0 ? std::fabs(std::log(evidence.step_height / h)) : 2.0;
+  check.score = (check.holds ? 10.0 : 0.0) + 2.0 * evidence.step_share * std::min(1.0, measured / 0.6) +
+                std::min(coarse_iou, 0.8) - 0.5 * std::min(ratio, 2.0);
+  return check;
+}
+
+}  // namespace relief_snake
