@@ -25,6 +25,7 @@
 
 #include "relief_snake/error.hpp"
 #include "relief_snake/option_table.hpp"
+#include "relief_snake/result_json.hpp"
 #include "relief_snake/mesh.hpp"
 #include "relief_snake/segment.hpp"
 
@@ -157,24 +158,6 @@ void check_vertex(const rs::Mesh& mesh, std::int64_t index, const std::string& w
                     " is in no face of the mesh (unused or in a refused face); pick a vertex on the surface");
 }
 
-json report_json(const rs::Mesh& mesh, const std::string& path) {
-  const rs::MeshReport& r = mesh.report();
-  return json{{"path", path},
-              {"input_vertices", r.input_vertices},
-              {"input_faces", r.input_faces},
-              {"vertices", mesh.n_vertices()},
-              {"triangles", r.triangles},
-              {"polygons_triangulated", r.polygons_triangulated},
-              {"duplicate_vertices_merged", r.duplicate_vertices_merged},
-              {"unreferenced_vertices", r.unreferenced_vertices},
-              {"degenerate_faces", r.degenerate_faces},
-              {"nonmanifold_faces", r.nonmanifold_faces},
-              {"components", r.components},
-              {"boundary_edges", r.boundary_edges},
-              {"average_edge_length", mesh.average_edge_length()},
-              {"bbox_diagonal", mesh.bbox_diagonal()},
-              {"summary", r.summary()}};
-}
 
 // --- commands ------------------------------------------------------------------
 
@@ -328,39 +311,12 @@ int run_segment(const std::vector<std::string>& args) {
   const rs::Result result = rs::segment(mesh, a.picks, a.options, progress);
   const double segment_seconds = seconds_since(start);
 
-  json contour = json::array();
-  for (const rs::Vec3& p : result.polyline) contour.push_back({p.x(), p.y(), p.z()});
-  json phases = json::array();
-  for (const rs::PhaseStats& s : result.phases)
-    phases.push_back({{"name", s.name},
-                      {"iterations", s.iterations},
-                      {"snaxels", s.snaxels},
-                      {"seconds", s.seconds},
-                      {"converged", s.converged}});
-  const rs::Options& o = a.options;
-  const rs::DerivedParameters& d = result.parameters;
-  json parameters = {{"step_height", o.step_height},
-                     {"w_int", o.w_int},
-                     {"open", !o.closed},
-                     {"relief_side", rs::to_string(result.relief_side)},
-                     {"picks", a.picks},
-                     {"max_iterations", o.max_iterations}};
-  for (const rs::OptionInfo& option : rs::advanced_options())
-    parameters[option.name] = json::parse(rs::advanced_option_json(o, option.name));
-  for (const auto& [name, value] : d.named_values()) parameters[name] = value;
-  const json out = {{"status", rs::to_string(result.status)},
-                    {"closed", result.closed},
-                    {"contour", contour},
-                    {"relief_vertices", result.relief_vertices},
-                    {"phases", phases},
-                    {"parameters", parameters},
-                    {"mesh", report_json(mesh, a.mesh_path)},
-                    {"planarity_vertices", result.planarity_vertices},
-                    {"notes", result.notes},
-                    {"message", result.message},
-                    {"reasons", result.reasons},
-                    {"checks", json(std::map<std::string, double>(result.checks.begin(), result.checks.end()))},
-                    {"timing", {{"load_seconds", load_seconds}, {"segment_seconds", segment_seconds}}}};
+  rs::ResultContext context;
+  context.mesh_path = a.mesh_path;
+  context.picks = a.picks;
+  context.load_seconds = load_seconds;
+  context.segment_seconds = segment_seconds;
+  const json out = rs::to_json(result, a.options, mesh, context);
   const std::string text = out.dump(2) + "\n";
   if (a.out_path.empty()) {
     std::cout << text;

@@ -23,6 +23,7 @@
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
 #include "relief_snake/option_table.hpp"
+#include "relief_snake/result_json.hpp"
 #include "relief_snake/segment.hpp"
 
 #ifndef RELIEF_SNAKE_VERSION
@@ -271,19 +272,47 @@ py::object option_value(const Options& options, const OptionInfo& info) {
   return info.type == OptionType::Number ? py::float_(value) : value;
 }
 
-Options make_options(double step_height, double w_int, bool open_contour, const std::string& relief_side,
-                     int max_iterations, const py::kwargs& advanced) {
-  if (!std::isfinite(step_height) || step_height <= 0)
-    throw Error("step_height must be a finite number > 0 (measure the relief's step, e.g. with measure())");
-  if (!std::isfinite(w_int) || w_int <= 0 || w_int > 1) throw Error("w_int must be in (0, 1]; the paper uses 0.25");
-  if (relief_side != "left" && relief_side != "right")
-    throw Error("relief_side must be \"left\" or \"right\", got \"" + relief_side + "\"");
+// step_height: None (estimate it) or a number > 0; w_int: None or "auto" (the engine
+// chooses) or a number in (0, 1]. Range checks beyond these are the engine's (validate_options).
+double step_height_arg(py::handle value) {
+  if (value.is_none()) return kAuto;
+  if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()))
+    throw py::type_error("step_height must be a number > 0 or None (estimate it), got " +
+                         std::string(py::str(py::repr(value))));
+  const double h = py::float_(py::reinterpret_borrow<py::object>(value));
+  if (!std::isfinite(h) || h <= 0)
+    throw Error("step_height must be a finite number > 0, or None to estimate it (got " +
+                std::string(py::str(py::repr(value))) + ")");
+  return h;
+}
+
+double w_int_arg(py::handle value) {
+  if (value.is_none()) return kAuto;
+  if (PyUnicode_Check(value.ptr())) {
+    if (value.cast<std::string>() == "auto") return kAuto;
+    throw Error("w_int must be a number in (0, 1] or 'auto', got " + std::string(py::str(py::repr(value))));
+  }
+  if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()))
+    throw py::type_error("w_int must be a number in (0, 1] or 'auto', got " + std::string(py::str(py::repr(value))));
+  const double w = py::float_(py::reinterpret_borrow<py::object>(value));
+  if (!std::isfinite(w) || w <= 0 || w > 1) throw Error("w_int must be in (0, 1] or 'auto'; the paper uses 0.25");
+  return w;
+}
+
+Options make_options(py::handle step_height_value, py::handle w_int_value, bool open_contour,
+                     const std::string& relief_side, int max_iterations, const py::kwargs& advanced) {
+  const double step_height = step_height_arg(step_height_value);
+  const double w_int = w_int_arg(w_int_value);
+  if (relief_side != "left" && relief_side != "right" && relief_side != "auto")
+    throw Error("relief_side must be \"left\", \"right\" or \"auto\", got \"" + relief_side + "\"");
   if (max_iterations < 1) throw Error("max_iterations must be at least 1");
   Options options;
   options.step_height = step_height;
   options.w_int = w_int;
   options.closed = !open_contour;
-  options.relief_side = relief_side == "left" ? ReliefSide::Left : ReliefSide::Right;
+  options.relief_side = relief_side == "left"    ? ReliefSide::Left
+                         : relief_side == "right" ? ReliefSide::Right
+                                                  : ReliefSide::Auto;
   options.max_iterations = max_iterations;
   for (const auto& [key, value] : advanced) {
     const std::string name = py::str(key);
@@ -305,42 +334,40 @@ std::vector<std::int64_t> read_picks(py::handle picks) {
 
 py::tuple point(const Vec3& p) { return py::make_tuple(p.x(), p.y(), p.z()); }
 
-py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, double seconds) {
+// The result document (result_json.hpp) as Python objects.
+py::object to_python(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::null: return py::none();
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string: return py::str(j.get_ref<const std::string&>());
+    case nlohmann::json::value_t::array: {
+      py::list out;
+      for (const auto& item : j) out.append(to_python(item));
+      return std::move(out);
+    }
+    case nlohmann::json::value_t::object: {
+      py::dict out;
+      for (auto it = j.begin(); it != j.end(); ++it) out[py::str(it.key())] = to_python(it.value());
+      return std::move(out);
+    }
+    default: return py::none();
+  }
+}
+
+py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, const std::vector<std::int64_t>& picks,
+                     double load_seconds, double segment_seconds) {
+  ResultContext context;
+  context.picks = picks;
+  context.load_seconds = load_seconds;
+  context.segment_seconds = segment_seconds;
+  // Contour points as tuples, the form Blender's foreach_set and the add-on take.
+  py::dict out = to_python(to_json(r, o, mesh, context));
   py::list contour;
   for (const Vec3& p : r.polyline) contour.append(point(p));
-  py::list phases;
-  for (const PhaseStats& s : r.phases) {
-    py::dict phase;
-    phase["name"] = s.name;
-    phase["iterations"] = s.iterations;
-    phase["snaxels"] = s.snaxels;
-    phase["seconds"] = s.seconds;
-    phase["converged"] = s.converged;
-    phases.append(phase);
-  }
-  const DerivedParameters& d = r.parameters;
-  py::dict parameters;
-  for (const auto& [name, value] : d.named_values()) parameters[name] = value;
-  parameters["step_height"] = o.step_height;
-  parameters["open"] = !o.closed;
-  parameters["relief_side"] = o.relief_side == ReliefSide::Left ? "left" : "right";
-  parameters["max_iterations"] = o.max_iterations;
-  parameters["w_int"] = o.w_int;
-  for (const OptionInfo& option : advanced_options()) parameters[option.name] = option_value(o, option);
-
-  py::dict out;
-  out["status"] = to_string(r.status);
-  out["closed"] = r.closed;
   out["contour"] = contour;
-  py::list relief;
-  for (std::int64_t v : r.relief_vertices) relief.append(v);
-  out["relief_vertices"] = relief;
-  out["phases"] = phases;
-  out["parameters"] = parameters;
-  out["planarity_vertices"] = r.planarity_vertices;
-  out["notes"] = py::cast(r.notes);
-  out["mesh_report"] = mesh.report().summary();
-  out["seconds"] = seconds;
   return out;
 }
 
@@ -401,9 +428,8 @@ py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lo
   }
   if (callback_error) std::rethrow_exception(callback_error);
   if (result.status == Status::Cancelled) throw CancelledError();
-  const double seconds =
-      seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result_dict(result, options, mesh, seconds);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result_dict(result, options, mesh, picks, seconds_before, seconds);
 }
 
 /// The Python Mesh: a validated mesh and its Segmenter (planarity cache), kept together.
@@ -414,7 +440,7 @@ class PyMesh {
     segmenter_ = std::make_unique<Segmenter>(*mesh_);
   }
 
-  py::dict segment(py::object picks, double step_height, double w_int, bool open_contour,
+  py::dict segment(py::object picks, py::object step_height, py::object w_int, bool open_contour,
                    const std::string& relief_side, int max_iterations, py::object progress, const py::kwargs& advanced) {
     const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
     return run_segmentation(*segmenter_, *mesh_, &lock_, picks, options, std::move(progress), 0.0);
@@ -457,20 +483,24 @@ PYBIND11_MODULE(relief_snake_core, m) {
   m.attr("Cancelled").attr("__doc__") = "The progress callback returned False.";
 
   const char* segment_doc =
-      "segment(vertices, triangles, picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left',\n"
+      "segment(vertices, triangles, picks, step_height=None, *, w_int='auto', open_contour=False,\n"
+      "        relief_side='auto',\n"
       "        max_iterations=3000, progress=None, **advanced) -> dict\n\n"
       "vertices: n by 3 (or flat 3n) floats; triangles: m by 3 (or flat 3m) integer vertex indices;\n"
-      "picks: vertex indices around the relief, in order (>= 3 closed, >= 2 open); step_height: h > 0.\n"
+      "picks: vertex indices around the relief, in order (>= 3 closed, >= 2 open); step_height: h > 0, or\n"
+      "None to estimate it; w_int: in (0, 1] or 'auto'; relief_side (open contours): 'left', 'right' or\n"
+      "'auto' (the side that rises).\n"
       "progress(phase: str, iteration: int, snaxels: int, contour: list of (x, y, z) or None) -> bool|None is\n"
       "called every iteration (contour: at each phase's first call and then at most every 0.1 s, None in\n"
-      "between); returning False raises Cancelled. Returns a dict with status, closed, contour,\n"
-      "relief_vertices, phases, parameters, planarity_vertices, notes, mesh_report and seconds.\n"
+      "between); returning False raises Cancelled. Returns the result document of docs/result-format.md\n"
+      "(status: converged, doubtful or iteration_cap, with message and reasons; contour; relief_vertices;\n"
+      "step_height; checks; phases; parameters; notes; mesh; timing), the same as the CLI writes.\n"
       "**advanced: the engine's advanced options by name (e.g. tau=0.2, exact_q=True); advanced_options()\n"
       "lists them with their types, ranges and defaults. An unknown name raises TypeError.";
 
   m.def(
       "segment",
-      [](py::object vertices, py::object triangles, py::object picks, double step_height, double w_int,
+      [](py::object vertices, py::object triangles, py::object picks, py::object step_height, py::object w_int,
          bool open_contour, const std::string& relief_side, int max_iterations, py::object progress,
          const py::kwargs& advanced) {
         // Options are checked before the (possibly long) mesh construction.
@@ -486,8 +516,8 @@ PYBIND11_MODULE(relief_snake_core, m) {
         const double before = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return run_segmentation(*segmenter, *mesh, &lock, picks, options, std::move(progress), before);
       },
-      py::arg("vertices"), py::arg("triangles"), py::arg("picks"), py::arg("step_height"), py::kw_only(),
-      py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
+      py::arg("vertices"), py::arg("triangles"), py::arg("picks"), py::arg("step_height") = py::none(), py::kw_only(),
+      py::arg("w_int") = "auto", py::arg("open_contour") = false, py::arg("relief_side") = "auto",
       py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), segment_doc);
 
   m.def(
@@ -531,10 +561,10 @@ PYBIND11_MODULE(relief_snake_core, m) {
       .def_property_readonly("n_vertices", [](const PyMesh& self) { return self.mesh().n_vertices(); })
       .def_property_readonly("n_faces", [](const PyMesh& self) { return self.mesh().n_faces(); })
       .def_property_readonly("average_edge", [](const PyMesh& self) { return self.mesh().average_edge_length(); })
-      .def("segment", &PyMesh::segment, py::arg("picks"), py::arg("step_height"), py::kw_only(),
-           py::arg("w_int") = 0.25, py::arg("open_contour") = false, py::arg("relief_side") = "left",
+      .def("segment", &PyMesh::segment, py::arg("picks"), py::arg("step_height") = py::none(), py::kw_only(),
+           py::arg("w_int") = "auto", py::arg("open_contour") = false, py::arg("relief_side") = "auto",
            py::arg("max_iterations") = 3000, py::arg("progress") = py::none(),
-           "segment(picks, step_height, *, w_int=0.25, open_contour=False, relief_side='left', "
+           "segment(picks, step_height=None, *, w_int='auto', open_contour=False, relief_side='auto', "
            "max_iterations=3000, progress=None, **advanced) -> dict (see relief_snake_core.segment)")
       .def("measure", &PyMesh::measure, py::arg("i"), py::arg("j"),
            "measure(i, j) -> float: Euclidean distance between input vertices i and j.")

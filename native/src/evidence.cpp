@@ -146,8 +146,17 @@ std::string number(double x) {
 }
 }  // namespace
 
-SelfCheck judge(const StepEvidence& evidence, double coarse_iou, double h, const SelfCheckOptions& options) {
+double enclosed_area(const std::vector<Vec3>& polyline) {
+  Vec3 area = Vec3::Zero();
+  const std::size_t n = polyline.size();
+  for (std::size_t i = 0; i < n; ++i)
+    area += (polyline[i] - polyline[0]).cross(polyline[(i + 1) % n] - polyline[0]);
+  return 0.5 * area.norm();
+}
+
+SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options) {
   SelfCheck check;
+  const StepEvidence& evidence = all.step;
   const double measured = evidence.measured_share();
   if (measured < options.min_measured_share)
     check.reasons.push_back("the step could be measured along only " + percent(measured) +
@@ -156,13 +165,23 @@ SelfCheck judge(const StepEvidence& evidence, double coarse_iou, double h, const
     check.reasons.push_back("only " + percent(evidence.step_share) +
                             " of the contour runs along a step: it may have crossed into the relief or stopped "
                             "on detail or texture");
-  if (coarse_iou < options.min_coarse_iou)
-    check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(coarse_iou) +
+  // A coarse contour that sat on a step and a refinement that left it far behind: the
+  // deflation carried the snake across the step. (A coarse contour still on the
+  // background, from picks far out, may rightly be left behind.)
+  if (all.coarse_step_share >= options.min_step_share && all.coarse_iou < options.min_coarse_iou)
+    check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(all.coarse_iou) +
                             ": refinement moved far from where the step was first found");
+  if (all.area_ratio > options.max_area_ratio || all.area_ratio * options.max_area_ratio < 1)
+    check.reasons.push_back("the relief region covers " + number(all.area_ratio) +
+                            " times the area the contour encloses: the contour may cross itself");
+  if (all.other_side_share > evidence.step_share)
+    check.reasons.push_back("the step looks clearer from the other side of the contour: the relief side may be "
+                            "wrong (give it)");
   if (evidence.step_height > 0 &&
       (evidence.step_height > options.max_step_ratio * h || evidence.step_height * options.max_step_ratio < h))
     check.reasons.push_back("the step along the contour is " + number(evidence.step_height) +
                             " high, far from the step height used (" + number(h) + ")");
+  const double coarse_iou = all.coarse_step_share >= options.min_step_share ? all.coarse_iou : 1.0;
   check.holds = check.reasons.empty();
   // Prefer evidence that holds; then more of the contour on a step, a region that agrees
   // with the coarse phase, and a step that agrees with h.

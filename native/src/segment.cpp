@@ -141,8 +141,7 @@ struct Attempt {
   double h = 0, w_int = 0;
   ScheduleRun run;
   std::vector<char> region;
-  StepEvidence evidence;
-  double coarse_iou = 1;
+  ContourEvidence evidence;
   SelfCheck check;
   DerivedParameters parameters;
   std::vector<std::string> notes;
@@ -154,8 +153,8 @@ bool better(const Attempt& a, const Attempt& b) {
   if (a.usable() != b.usable()) return a.usable();
   if (a.check.holds != b.check.holds) return a.check.holds;
   if (a.check.holds) {  // both hold: the one whose step agrees with its own h
-    const double ra = std::fabs(std::log(a.evidence.step_height / a.h));
-    const double rb = std::fabs(std::log(b.evidence.step_height / b.h));
+    const double ra = std::fabs(std::log(a.evidence.step.step_height / a.h));
+    const double rb = std::fabs(std::log(b.evidence.step.step_height / b.h));
     if (std::fabs(ra - rb) > 0.1) return ra < rb;
   }
   return a.check.score > b.check.score;
@@ -267,6 +266,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       return best;
     }
     const std::vector<char> coarse_region = relief_region(mesh, coarse.contour, options.closed, inside_left);
+    const double coarse_step_share = measure_step(mesh, coarse.contour, coarse_region, h_try).step_share;
     bool first = true;
     for (const double w : w_steps) {
       Attempt a;
@@ -304,9 +304,19 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.run.contour = snake.points();
       }
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
-      a.evidence = measure_step(mesh, a.run.contour, a.region, h_try);
-      a.coarse_iou = region_iou(mesh, coarse_region, a.region);
-      a.check = judge(a.evidence, a.coarse_iou, h_try);
+      a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try);
+      a.evidence.coarse_step_share = coarse_step_share;
+      a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
+      if (options.closed) {
+        std::vector<Vec3> polyline;
+        for (const SurfacePoint& p : a.run.contour) polyline.push_back(position(mesh, p));
+        const double enclosed = enclosed_area(polyline);
+        a.evidence.area_ratio = enclosed > 0 ? region_area(mesh, a.region) / enclosed : 0.0;
+      } else if (!side_given) {
+        const std::vector<char> other = relief_region(mesh, a.run.contour, false, !inside_left);
+        a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try).step_share;
+      }
+      a.check = judge(a.evidence, h_try);
       const bool holds = a.check.holds;
       if (first || better(a, best)) best = std::move(a);
       first = false;
@@ -318,7 +328,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   Attempt best = attempt_at(h);
   std::vector<double> tried = {h};
   for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
-    const double found = best.evidence.step_height;
+    const double found = best.evidence.step.step_height;
     if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
     bool near_tried = false;
     for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
@@ -367,11 +377,12 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   param.step_height = best.h;
   if (!h_given && std::fabs(std::log(best.h / h)) > 1e-12) {
     // Refitted from the contour: as sure as the step found along it is even.
-    result.step_height_confidence = std::clamp(1.0 - best.evidence.step_spread, 0.0, 1.0) * best.evidence.step_share;
+    result.step_height_confidence =
+        std::clamp(1.0 - best.evidence.step.step_spread, 0.0, 1.0) * best.evidence.step.step_share;
   } else if (!h_given) {
     result.step_height_confidence =
         std::max(result.step_height_confidence,
-                 std::clamp(1.0 - best.evidence.step_spread, 0.0, 1.0) * best.evidence.step_share);
+                 std::clamp(1.0 - best.evidence.step.step_spread, 0.0, 1.0) * best.evidence.step.step_share);
   }
 
   result.contour = best.run.contour;
@@ -382,14 +393,18 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     if (v >= 0 && best.region[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
   }
 
-  result.checks = {{"step_share", best.evidence.step_share},
-                   {"step_height", best.evidence.step_height},
-                   {"rise_median", best.evidence.rise_median},
-                   {"step_spread", best.evidence.step_spread},
-                   {"background_residual", best.evidence.background_residual},
-                   {"measured_share", best.evidence.measured_share()},
-                   {"coarse_iou", best.coarse_iou},
+  const StepEvidence& step = best.evidence.step;
+  result.checks = {{"step_share", step.step_share},
+                   {"step_height", step.step_height},
+                   {"rise_median", step.rise_median},
+                   {"step_spread", step.step_spread},
+                   {"background_residual", step.background_residual},
+                   {"measured_share", step.measured_share()},
+                   {"coarse_step_share", best.evidence.coarse_step_share},
+                   {"coarse_iou", best.evidence.coarse_iou},
+                   {"area_ratio", best.evidence.area_ratio},
                    {"region_area", region_area(mesh, best.region)}};
+  if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (best.run.hit_cap) {
     result.status = Status::IterationCap;

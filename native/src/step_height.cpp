@@ -125,11 +125,33 @@ Split otsu(const std::vector<WeightedHeight>& values, int bins) {
   return split;
 }
 
-std::vector<WeightedHeight> heights_of(const Mesh& mesh, const std::vector<char>& region, const QuadraticBackground& bg) {
+std::vector<WeightedHeight> heights_of(const Mesh& mesh, const std::vector<char>& region, const QuadraticBackground& bg,
+                                       const std::vector<char>* near = nullptr) {
   std::vector<WeightedHeight> out;
   for (int v = 0; v < mesh.n_vertices(); ++v)
-    if (region[v]) out.push_back({bg.height(mesh.position(v)), mesh.vertex_area(v)});
+    if (region[v] && (!near || (*near)[v])) out.push_back({bg.height(mesh.position(v)), mesh.vertex_area(v)});
   return out;
+}
+
+// Vertices within `distance` of the samples (straight distance to the sample a
+// breadth-first search from it reached them through), so both sides of an open contour
+// are compared over the same strip and the fit is not continued far from its samples.
+std::vector<char> near_samples(const Mesh& mesh, const std::vector<int>& samples, double distance) {
+  std::vector<char> near(mesh.n_vertices(), 0);
+  std::vector<int> source(mesh.n_vertices(), -1), queue;
+  for (const int v : samples) source[v] = v, near[v] = 1, queue.push_back(v);
+  const double d2 = distance * distance;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w) {
+      if (source[*w] >= 0) continue;
+      source[*w] = source[v];
+      if ((mesh.position(*w) - mesh.position(source[v])).squaredNorm() > d2) continue;
+      near[*w] = 1;
+      queue.push_back(*w);
+    }
+  }
+  return near;
 }
 
 }  // namespace
@@ -162,9 +184,11 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   if (closed) {
     heights = heights_of(mesh, relief_region(mesh, path, true, inside_left), background);
   } else {
-    // The relief is on the side that rises above the background.
-    const auto left = heights_of(mesh, relief_region(mesh, path, false, true), background);
-    const auto right = heights_of(mesh, relief_region(mesh, path, false, false), background);
+    // The relief is on the side that rises above the background, compared over a strip
+    // along the contour (a tenth of its length wide) where the fit can be trusted.
+    const std::vector<char> near = near_samples(mesh, samples, 0.1 * path_length(mesh, path, false));
+    const auto left = heights_of(mesh, relief_region(mesh, path, false, true), background, &near);
+    const auto right = heights_of(mesh, relief_region(mesh, path, false, false), background, &near);
     estimate.left_rise = weighted_quantile(left, 0.9);
     estimate.right_rise = weighted_quantile(right, 0.9);
     estimate.relief_left = estimate.left_rise >= estimate.right_rise;
@@ -187,6 +211,9 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   const double clean = std::clamp((split.separation - options.min_separation) / (1 - options.min_separation), 0.0, 1.0);
   const double above_noise = std::clamp(value / (10 * background.residual + 1e-300) , 0.0, 1.0);
   estimate.confidence = clean * above_noise;
+  // A step a sizeable part of the contour's own size is no relief step: unsure.
+  const double size = path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
+  if (value > 0.25 * size) estimate.confidence = 0;
   return estimate;
 }
 

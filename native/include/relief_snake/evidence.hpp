@@ -65,6 +65,18 @@ struct SelfCheckOptions {
   double min_measured_share = 0.3;  ///< below this the step could not be checked at all
   double min_coarse_iou = 0.6;    ///< overlap of the final region with the coarse phase's
   double max_step_ratio = 2.0;    ///< the step found and h may differ by at most this factor
+  /// Closed contours: the region's area against the area the contour encloses (its vector
+  /// area); outside [1 / max_area_ratio, max_area_ratio] the region leaked or lost a piece.
+  double max_area_ratio = 1.35;
+};
+
+/// Everything the self-check looks at for one contour.
+struct ContourEvidence {
+  StepEvidence step;            ///< along the final contour
+  double coarse_step_share = 0; ///< the coarse contour's share on a step
+  double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
+  double area_ratio = 1;        ///< region area / enclosed (vector) area; 1 for open contours
+  double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
 };
 
 /// The verdict on one contour.
@@ -74,9 +86,11 @@ struct SelfCheck {
   std::vector<std::string> reasons;  ///< one plain sentence per failed check
 };
 
-/// Judges a contour's evidence. coarse_iou: area IoU of the final region with the coarse
-/// contour's (1 if there is none); h: the step height used.
-SelfCheck judge(const StepEvidence& evidence, double coarse_iou, double h, const SelfCheckOptions& options = {});
+/// Judges a contour's evidence; h: the step height used.
+SelfCheck judge(const ContourEvidence& evidence, double h, const SelfCheckOptions& options = {});
+
+/// Magnitude of the vector area of a closed polyline: the area it encloses on a gently curved surface.
+double enclosed_area(const std::vector<Vec3>& closed_polyline);
 
 /// Area (sum of vertex areas) of the flagged vertices.
 double region_area(const Mesh& mesh, const std::vector<char>& region);

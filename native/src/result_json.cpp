@@ -1,0 +1,75 @@
+// The result document shared by the CLI and the Python module.
+#include "relief_snake/result_json.hpp"
+
+#include "relief_snake/option_table.hpp"
+
+namespace relief_snake {
+
+using nlohmann::json;
+
+json mesh_report_json(const Mesh& mesh, const std::string& path) {
+  const MeshReport& r = mesh.report();
+  return json{{"path", path},
+              {"input_vertices", r.input_vertices},
+              {"input_faces", r.input_faces},
+              {"vertices", mesh.n_vertices()},
+              {"triangles", r.triangles},
+              {"polygons_triangulated", r.polygons_triangulated},
+              {"duplicate_vertices_merged", r.duplicate_vertices_merged},
+              {"unreferenced_vertices", r.unreferenced_vertices},
+              {"degenerate_faces", r.degenerate_faces},
+              {"nonmanifold_faces", r.nonmanifold_faces},
+              {"components", r.components},
+              {"boundary_edges", r.boundary_edges},
+              {"average_edge_length", mesh.average_edge_length()},
+              {"bbox_diagonal", mesh.bbox_diagonal()},
+              {"summary", r.summary()}};
+}
+
+json to_json(const Result& result, const Options& options, const Mesh& mesh, const ResultContext& context) {
+  json contour = json::array();
+  for (const Vec3& p : result.polyline) contour.push_back({p.x(), p.y(), p.z()});
+  json phases = json::array();
+  for (const PhaseStats& s : result.phases)
+    phases.push_back({{"name", s.name},
+                      {"iterations", s.iterations},
+                      {"snaxels", s.snaxels},
+                      {"seconds", s.seconds},
+                      {"converged", s.converged}});
+  json parameters = {{"open", !options.closed},
+                     {"relief_side", to_string(result.relief_side)},
+                     {"picks", context.picks},
+                     {"max_iterations", options.max_iterations}};
+  for (const OptionInfo& option : advanced_options())
+    parameters[option.name] = json::parse(advanced_option_json(options, option.name));
+  // The values used (h, W_int and what derives from them), whether given or chosen.
+  for (const auto& [name, value] : result.parameters.named_values()) parameters[name] = value;
+  json checks = json::object();
+  for (const auto& [name, value] : result.checks) checks[name] = value;
+  const bool h_given = options.step_height > 0;
+  json step_height = {{"used", result.parameters.step_height},
+                      {"given", h_given ? json(options.step_height) : json(nullptr)},
+                      {"estimate", h_given ? json(nullptr) : json(result.step_height_estimate)},
+                      {"confidence", result.step_height_confidence}};
+  return json{{"format", "relief-snake-result/1"},
+              {"status", to_string(result.status)},
+              {"message", result.message},
+              {"reasons", result.reasons},
+              {"closed", result.closed},
+              {"relief_side", result.closed ? json(nullptr) : json(to_string(result.relief_side))},
+              {"contour", contour},
+              {"relief_vertices", result.relief_vertices},
+              {"step_height", step_height},
+              {"w_int", {{"used", result.parameters.w_int},
+                         {"given", options.w_int > 0 ? json(options.w_int) : json(nullptr)}}},
+              {"checks", checks},
+              {"attempts", result.attempts},
+              {"phases", phases},
+              {"parameters", parameters},
+              {"notes", result.notes},
+              {"planarity_vertices", result.planarity_vertices},
+              {"mesh", mesh_report_json(mesh, context.mesh_path)},
+              {"timing", {{"load_seconds", context.load_seconds}, {"segment_seconds", context.segment_seconds}}}};
+}
+
+}  // namespace relief_snake
