@@ -89,7 +89,12 @@ RandomDraw draw_random(std::uint64_t seed, int attempt) {
 
   // Shape.
   const char* shape_names[] = {"duck", "gear", "c", "ellipse", "rounded-box", "letter", "band", "open"};
-  const int shape = r.pick({2, 1.5, 1.5, 0.75, 0.75, 1.5, 1.5, 0.5});
+  int shape = r.pick({2, 1.5, 1.5, 0.75, 0.75, 1.5, 1.5, 0.5});
+  // Concavities narrower than about 2 h (the h-ball does not fit: no planar floor) or 6 edges (the
+  // paper: the snake does not enter mouths of 4-6 edges) cannot be entered by design; draw none.
+  const double mouth = std::max(2 * h, 6 * edge);
+  if (shape == 0 && h > 1.75) shape = 3;  // the duck's pocket under the beak is 3.5 wide
+  axes["min_mouth"] = mouth;
   axes["shape"] = shape_names[shape];
   const bool closed_shape = shape != 6 && shape != 7;
   if (closed_shape) {
@@ -102,9 +107,9 @@ RandomDraw draw_random(std::uint64_t seed, int attempt) {
     case 1: {
       sp.shape = Shape::Gear;
       sp.gear_radius = r.range(11, 16);
-      const int n = r.integer(3, 8);
+      const int n = r.integer(3, 6);
       sp.slot_widths.clear();
-      for (int k = 0; k < n; ++k) sp.slot_widths.push_back(r.log_range(2, 12));
+      for (int k = 0; k < n; ++k) sp.slot_widths.push_back(mouth / edge * r.range(1, 2));
       sp.gear_slot_depth = std::min({r.range(1.5, 5) * h, 0.6 * sp.gear_radius, sp.gear_radius - 2 * h - 0.5});
       axes["slots"] = n;
       axes["slot_min_edges"] = *std::min_element(sp.slot_widths.begin(), sp.slot_widths.end());
@@ -114,8 +119,8 @@ RandomDraw draw_random(std::uint64_t seed, int attempt) {
       sp.shape = Shape::CShape;
       sp.c_radius = r.range(10, 15);
       sp.c_half_thickness = std::min(std::max(1.5 * h, 2.5) + r.range(0, 3), 0.45 * sp.c_radius);
-      const double gap_edges = r.log_range(3, 15);
-      sp.c_gap_width = gap_edges * edge;
+      sp.c_gap_width = mouth * r.range(1, 2.5);
+      const double gap_edges = sp.c_gap_width / edge;
       sp.c_gap_angle = r.range(0, 2 * M_PI);
       axes["gap_edges"] = gap_edges;
       break;
@@ -213,7 +218,7 @@ RandomDraw draw_random(std::uint64_t seed, int attempt) {
 
   // Triangulation: jittered, sometimes graded.
   sp.jitter = r.range(0, 0.34);
-  if (r.chance(0.4)) sp.grade_u = r.range(0, 0.5), sp.grade_v = r.range(0, 0.5);
+  if (r.chance(0.4)) sp.grade_u = r.range(0, 0.35), sp.grade_v = r.range(0, 0.35);
   axes["jitter"] = sp.jitter;
   axes["graded"] = sp.grade_u > 0 || sp.grade_v > 0;
 
@@ -268,6 +273,17 @@ RandomScan generate_random(std::uint64_t seed) {
   std::string last_error = "no attempt";
   for (int attempt = 0; attempt < 50; ++attempt) {
     RandomDraw draw = draw_random(seed, attempt);
+    const ScanSpec& sp = draw.spec;
+    if (sp.shape == Shape::Letter) {
+      // The letters' mouths must be enterable too (see draw_random).
+      const double mouth = draw.axes["min_mouth"].get<double>();
+      const double e_mouth = 0.5 * (2 * sp.letter_half_v - 3 * sp.stroke_width);
+      const double u_mouth = 2 * sp.letter_half_u - 2 * sp.stroke_width;
+      if ((sp.letter == 'E' && e_mouth < mouth) || ((sp.letter == 'U' || sp.letter == 'H') && u_mouth < mouth)) {
+        last_error = "the letter's mouth is too narrow";
+        continue;
+      }
+    }
     try {
       Scan scan = generate(draw.spec);
       const bool open_shape = draw.spec.shape == Shape::Band || draw.spec.shape == Shape::Open;
