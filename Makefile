@@ -3,7 +3,7 @@ PYTHON ?= python3
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test test-native test-python test-blender test-package demo clean wheel package bench
+.PHONY: deps build test test-native test-python test-blender test-package demo clean wheel package bench bench-random
 
 deps:
 	@scripts/install-deps.sh
@@ -34,9 +34,14 @@ test: test-native test-python test-blender test-package
 demo: build
 	@scripts/demo.sh
 
-# The benchmark (issue 4): bench/results/report.md and plots; builds only what it runs.
+# The benchmark (issue 4): bench/results/report.md and plots; and the randomized suite (issue 14,
+# 200 random scans): bench/results/random/report.md. Builds only what it runs.
 bench: deps
 	@BUILD_DIR=$(BUILD_DIR) PYTHON=$(PYTHON) JOBS=$(JOBS) scripts/bench.sh
+
+# The randomized suite alone (RANDOM_SEEDS, RANDOM_ARGS: see scripts/bench.sh).
+bench-random: deps
+	@BUILD_DIR=$(BUILD_DIR) PYTHON=$(PYTHON) JOBS=$(JOBS) BENCH_SECTIONS=random scripts/bench.sh
 
 # Packaging: the relief_snake_core wheel, and the two add-on zips (legacy + 4.2 extension) in dist/.
 wheel: deps

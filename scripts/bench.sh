@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# `make bench`: the benchmark of issue 4. Builds relief-snake and make-scan (only those two
+# `make bench`: the benchmark of issues 4 and 14. Builds relief-snake and make-scan (only those two
 # targets) into $BUILD_DIR, installs matplotlib and numpy for the plots if missing, then runs
-# bench/run_bench.py, which writes bench/results/report.md and bench/results/*.png.
+# bench/run_bench.py (bench/results/report.md and bench/results/*.png) and the randomized suite
+# bench/random_suite.py (bench/results/random/report.md and results.json).
 # It reports numbers; it does not fail on them (it exits non-zero only if it cannot run).
 # Environment: BUILD_DIR [build], PYTHON [python3], JOBS [2] (build), BENCH_JOBS [2] (parallel
-# accuracy runs), BENCH_ARGS (extra arguments for run_bench.py, e.g. --quick or --keep-scans).
+# runs), BENCH_ARGS (extra arguments for run_bench.py, e.g. --quick or --keep-scans),
+# BENCH_SECTIONS ["main random"], RANDOM_SEEDS [0:200], RANDOM_ARGS (extra arguments for
+# random_suite.py, e.g. --variant NAME=OPTIONS; without --variant it runs defaults, paper, old-defaults).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,5 +24,13 @@ echo "bench: building relief-snake and make-scan in $BUILD_DIR" >&2
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE="$(command -v "$PYTHON")" >/dev/null
 cmake --build "$BUILD_DIR" -j "${JOBS:-2}" --target relief-snake make-scan >/dev/null
 
+SECTIONS=${BENCH_SECTIONS:-main random}
 # shellcheck disable=SC2086
-exec "$PYTHON" bench/run_bench.py --build-dir "$BUILD_DIR" ${BENCH_ARGS:-}
+if [[ " $SECTIONS " == *" main "* ]]; then
+  "$PYTHON" bench/run_bench.py --build-dir "$BUILD_DIR" ${BENCH_ARGS:-}
+fi
+# shellcheck disable=SC2086
+if [[ " $SECTIONS " == *" random "* ]]; then
+  "$PYTHON" -m bench.random_suite --cli "$BUILD_DIR/relief-snake" --make-scan "$BUILD_DIR/make-scan" \
+    --seeds "${RANDOM_SEEDS:-0:200}" --jobs "${BENCH_JOBS:-2}" --out bench/results/random ${RANDOM_ARGS:-}
+fi

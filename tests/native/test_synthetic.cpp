@@ -553,3 +553,137 @@ TEST(Synthetic, EngineMeshAcceptsTheScanUnchanged) {
   EXPECT_TRUE(mesh.is_boundary_vertex(mesh.input_to_mesh(p.vertices.front())));
   EXPECT_TRUE(mesh.is_boundary_vertex(mesh.input_to_mesh(p.vertices.back())));
 }
+
+// --- the random family (make-scan --random) ---------------------------------------------
+
+TEST(SyntheticRandom, DeterministicForASeedAndDifferentAcrossSeeds) {
+  const RandomScan a = generate_random(3), b = generate_random(3), c = generate_random(4);
+  EXPECT_EQ(a.scan.V, b.scan.V);
+  EXPECT_EQ(a.scan.F, b.scan.F);
+  EXPECT_EQ(a.picks.vertices, b.picks.vertices);
+  EXPECT_EQ(a.draw.axes, b.draw.axes);
+  EXPECT_NE(a.draw.axes, c.draw.axes);
+}
+
+TEST(SyntheticRandom, DrawsStayInTheirRanges) {
+  std::map<std::string, int> shapes, backgrounds, textures, details, starts;
+  for (std::uint64_t seed = 0; seed < 300; ++seed) {
+    const RandomDraw d = draw_random(seed);
+    ASSERT_GE(d.spec.triangles, 15000u);
+    ASSERT_LE(d.spec.triangles, 250000u);
+    const double h_edges = d.axes["h_edges"].get<double>();
+    ASSERT_GE(h_edges, 1.0);
+    ASSERT_LE(h_edges, 13.0);
+    ASSERT_GE(d.typed_factor, 0.5);
+    ASSERT_LE(d.typed_factor, 2.0);
+    ASSERT_LE(d.spec.noise, 0.05);
+    ASSERT_LE(std::abs(d.spec.texture_amplitude), 0.3);
+    if (d.spec.step == Step::Blended) ASSERT_LE(d.spec.blend_width, 1.0);
+    ++shapes[d.axes["shape"].get<std::string>()];
+    ++backgrounds[d.axes["background"].get<std::string>()];
+    ++textures[d.axes["texture"].get<std::string>()];
+    ++details[d.axes["detail"].get<std::string>()];
+    ++starts[d.axes["start"].get<std::string>()];
+  }
+  // Every value of every axis is drawn.
+  EXPECT_EQ(shapes.size(), 8u);
+  EXPECT_EQ(backgrounds.size(), 6u);
+  EXPECT_EQ(textures.size(), 3u);
+  EXPECT_EQ(details.size(), 6u);
+  EXPECT_EQ(starts.size(), 3u);
+}
+
+TEST(SyntheticRandom, ScansAreConsistentWithTheirTruth) {
+  for (std::uint64_t seed = 0; seed < 12; ++seed) {
+    const RandomScan r = generate_random(seed);
+    const Scan& s = r.scan;
+    SCOPED_TRACE("seed " + std::to_string(seed) + " " + r.draw.axes.dump());
+    const bool open_shape = s.spec.shape == Shape::Band || s.spec.shape == Shape::Open;
+    ASSERT_EQ(s.boundary.size(), 1u);
+    EXPECT_EQ(s.open, open_shape);
+    EXPECT_EQ(r.picks.closed, !open_shape);
+    EXPECT_NEAR(static_cast<double>(s.n_faces()), static_cast<double>(s.spec.triangles), 0.02 * s.spec.triangles);
+    // Relief flags are the silhouette; picks lie outside it, on the background.
+    for (std::size_t v = 0; v < s.n_vertices(); v += 7) ASSERT_EQ(s.relief[v] != 0, sd_at(s, v) < 0);
+    for (std::int64_t p : r.picks.vertices) EXPECT_GT(sd_at(s, p), 0.5 * s.h) << "pick " << p;
+    // Each vertex is its base plus the three heights along the background normal.
+    for (std::size_t v = 0; v < s.n_vertices(); v += 5) {
+      const double u = s.UV[2 * v], w = s.UV[2 * v + 1];
+      const Vec3 expected = s.surface(u, w, 0) +
+                            (s.relief_height[v] + s.texture_height[v] + s.noise_height[v]) * s.background_normal(u, w);
+      ASSERT_LT((s.vertex(v) - expected).norm(), 1e-9 * (1 + s.h)) << "vertex " << v;
+      if (!s.relief[v]) ASSERT_EQ(s.relief_height[v], 0.0);
+    }
+    const IouFloor floor = one_edge_floor(s);
+    EXPECT_GT(floor.area, 0.5);
+    EXPECT_LT(floor.area, 1.0);
+  }
+}
+
+TEST(SyntheticRandom, BackgroundNormalsAreUnitAndOrthogonalToTheSurface) {
+  for (Background bg : {Background::Vase, Background::Wavy}) {
+    ScanSpec spec = make_spec(Shape::Duck, bg, 20000);
+    const Scan s = generate(spec);
+    for (double u : {-30.0, -5.0, 12.0, 33.0})
+      for (double v : {-20.0, 0.0, 17.0}) {
+        const Vec3 n = s.background_normal(u, v);
+        EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+        const double e = 1e-5;
+        const Vec3 du = (s.surface(u + e, v) - s.surface(u - e, v)) / (2 * e);
+        const Vec3 dv = (s.surface(u, v + e) - s.surface(u, v - e)) / (2 * e);
+        EXPECT_NEAR(n.dot(du.normalized()), 0.0, 1e-6);
+        EXPECT_NEAR(n.dot(dv.normalized()), 0.0, 1e-6);
+        EXPECT_GT(n.dot(du.cross(dv)), 0);  // the +normal side sees (u, v) counter-clockwise
+      }
+  }
+}
+
+TEST(SyntheticRandom, TexturesStayWithinTheirAmplitudeOffTheRelief) {
+  for (Texture t : {Texture::Striations, Texture::Dots}) {
+    ScanSpec spec = make_spec(Shape::Disk, Background::Plane, 40000);
+    spec.texture = t;
+    spec.texture_amplitude = 0.25;
+    spec.texture_period = 3;
+    spec.dot_radius = 1.2;
+    const Scan s = generate(spec);
+    double lo = 0, hi = 0;
+    for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+      if (s.relief[v]) continue;
+      lo = std::min(lo, s.texture_height[v]), hi = std::max(hi, s.texture_height[v]);
+      ASSERT_NEAR(s.vertex(v).z(), s.texture_height[v], 1e-12);
+    }
+    EXPECT_GE(lo, t == Texture::Dots ? 0.0 : -0.25 - 1e-12);
+    EXPECT_LE(hi, 0.25 + 1e-12);
+    EXPECT_GT(hi, 0.2);  // the texture is there
+    // Sharp step: no texture on the relief's top.
+    for (std::size_t v = 0; v < s.n_vertices(); ++v)
+      if (s.relief[v]) ASSERT_EQ(s.texture_height[v], 0.0);
+  }
+}
+
+TEST(SyntheticRandom, OneEdgeFloorMatchesAnOffsetRegion) {
+  // A plane disk of radius 12 with a negligible step (so the wall adds no area): growing it by one
+  // edge e gives about (12 / (12 + e))^2.
+  ScanSpec spec = make_spec(Shape::Disk, Background::Plane, 60000);
+  spec.h = 0.02;
+  const Scan s = generate(spec);
+  const IouFloor floor = one_edge_floor(s);
+  const double expected = std::pow(12 / (12 + s.average_edge), 2);
+  EXPECT_NEAR(floor.area, expected, 0.1 * (1 - expected));
+  EXPECT_NEAR(floor.vertices, expected, 0.1 * (1 - expected));
+  // The same count by brute force over the boundary's segments.
+  const auto& pts = s.boundary[0].points;
+  std::size_t truth = 0, grown = 0;
+  for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+    bool near = s.relief[v] != 0;
+    if (!near && sd_at(s, v) > 2 * s.average_edge) continue;  // on the plane: far in (u, v) is far in 3D
+    for (std::size_t i = 0; i < pts.size() && !near; ++i) {
+      const Vec3 a = pts[i], b = pts[(i + 1) % pts.size()], p = s.vertex(v);
+      const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      near = (p - (a + t * (b - a))).norm() <= s.average_edge;
+    }
+    truth += s.relief[v], grown += near;
+  }
+  ASSERT_GT(grown, truth);
+  EXPECT_NEAR(floor.vertices, static_cast<double>(truth) / grown, 1e-12);
+}

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "relief_snake/error.hpp"
+#include "relief_snake/mesh.hpp"
 #include "synthetic.hpp"
 
 namespace rs = relief_snake;
@@ -22,9 +23,15 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  make-scan [options] --out PREFIX        writes PREFIX.ply (or .obj) and PREFIX.truth.json\n"
-    "  make-scan score TRUTH.json RESULT.json  prints {iou, mean/p95/max distances both ways, in average edges}\n"
+    "  make-scan --random SEED --out PREFIX    one scan of the random family: PREFIX.ply, PREFIX.json (truth),\n"
+    "                                          PREFIX.background.npy (per vertex base, normal, heights)\n"
+    "  make-scan score TRUTH.json RESULT.json [--mesh MESH]\n"
+    "                                          prints {iou, mean/p95/max distances both ways, in average edges};\n"
+    "                                          with --mesh also iou_area (vertex-area weighted) and the one-edge\n"
+    "                                          IoU floors (truth against truth grown by one average edge)\n"
     "options (defaults in brackets):\n"
-    "  --shape duck|disk|rectangle|slots|open [duck]    --background plane|cylinder|sphere|saddle [plane]\n"
+    "  --shape duck|disk|rectangle|slots|open|gear|c|ellipse|rounded-box|letter|band [duck]\n"
+    "  --background plane|cylinder|sphere|saddle|vase|wavy [plane]   --texture none|striations|dots [none]\n"
     "  --triangles N [100000]   --h H [1]   --seed K [1]   --radius R [40]   --width W [80]   --height H [56]\n"
     "  --step sharp|blended [sharp]   --blend-width B [0.5, in h]   --detail A [0, fraction of h]   --drop\n"
     "  --noise S [0, sigma as a fraction of h]   --jitter J [0.3]\n"
@@ -60,7 +67,7 @@ std::vector<rs::Vec3> points_of(const nlohmann::json& list) {
   return out;
 }
 
-int run_score(const std::string& truth_path, const std::string& result_path) {
+int run_score(const std::string& truth_path, const std::string& result_path, const std::string& mesh_path) {
   const nlohmann::json truth = read_json(truth_path), result = read_json(result_path);
   std::vector<syn::Polyline> boundary;
   const auto& b = truth.at("boundary");
@@ -95,7 +102,60 @@ int run_score(const std::string& truth_path, const std::string& result_path) {
                         {"p95_from_truth", s.p95_from_truth},
                         {"max_from_truth", s.max_from_truth},
                         {"units", "average edges"}};
+  if (!mesh_path.empty()) {
+    // Vertex-area weighted IoU, and the one-edge floors: the truth region against itself grown by
+    // every vertex within one average edge of the true boundary.
+    const rs::Mesh mesh = rs::Mesh::load(mesh_path);
+    const std::size_t n = mesh.input_vertex_count();
+    std::vector<char> in_truth(n, 0), in_result(n, 0);
+    for (std::int64_t v : truth.at("relief_vertices").get<std::vector<std::int64_t>>())
+      if (v >= 0 && static_cast<std::size_t>(v) < n) in_truth[v] = 1;
+    for (std::int64_t v : relief)
+      if (v >= 0 && static_cast<std::size_t>(v) < n) in_result[v] = 1;
+    const syn::PolylineDistance to_boundary(boundary);
+    const double edge = truth.at("average_edge").get<double>();
+    double common = 0, uni = 0, truth_n = 0, truth_a = 0, grown_n = 0, grown_a = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int m = mesh.input_to_mesh(i);
+      if (m < 0) continue;
+      const double a = mesh.vertex_area(m);
+      common += (in_truth[i] && in_result[i]) ? a : 0;
+      uni += (in_truth[i] || in_result[i]) ? a : 0;
+      const bool grown = in_truth[i] || to_boundary.within(mesh.position(m), edge);
+      truth_n += in_truth[i], truth_a += in_truth[i] ? a : 0;
+      grown_n += grown, grown_a += grown ? a : 0;
+    }
+    out["iou_area"] = uni > 0 ? common / uni : 1.0;
+    out["iou_floor_vertices"] = grown_n > 0 ? truth_n / grown_n : 1.0;
+    out["iou_floor_area"] = grown_a > 0 ? truth_a / grown_a : 1.0;
+  }
   std::cout << out.dump(2) << std::endl;
+  return 0;
+}
+
+int run_random(std::uint64_t seed, const std::string& out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const syn::RandomScan random = syn::generate_random(seed);
+  const std::string mesh_path = out + ".ply", truth_path = out + ".json", background_path = out + ".background.npy";
+  // The truth is written last, each file under a temporary name first: a PREFIX.json means a complete scan.
+  syn::write_ply(random.scan, mesh_path + ".tmp");
+  if (std::rename((mesh_path + ".tmp").c_str(), mesh_path.c_str()) != 0)
+    throw rs::Error("cannot rename " + mesh_path + ".tmp: check the folder is writable");
+  const std::size_t slash = background_path.find_last_of('/');
+  syn::write_background_npy(random.scan, background_path);
+  syn::write_json(syn::random_truth_json(random, slash == std::string::npos ? background_path
+                                                                              : background_path.substr(slash + 1)),
+                  truth_path);
+  const nlohmann::json summary = {{"mesh", mesh_path},
+                                  {"truth", truth_path},
+                                  {"background", background_path},
+                                  {"triangles", random.scan.n_faces()},
+                                  {"average_edge", random.scan.average_edge},
+                                  {"h", random.scan.h},
+                                  {"attempts", random.attempts},
+                                  {"axes", random.draw.axes},
+                                  {"total_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()}};
+  std::cout << summary.dump() << std::endl;
   return 0;
 }
 
@@ -106,8 +166,22 @@ int run(int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   if (args[0] == "score") {
-    if (args.size() != 3) throw rs::Error("score needs two files: make-scan score TRUTH.json RESULT.json");
-    return run_score(args[1], args[2]);
+    if (args.size() == 5 && args[3] == "--mesh") return run_score(args[1], args[2], args[4]);
+    if (args.size() != 3) throw rs::Error("score needs two files: make-scan score TRUTH.json RESULT.json [--mesh MESH]");
+    return run_score(args[1], args[2], "");
+  }
+  if (args[0] == "--random") {
+    if (args.size() != 4 || args[2] != "--out")
+      throw rs::Error("--random needs a seed and an output prefix: make-scan --random SEED --out PREFIX");
+    std::uint64_t seed = 0;
+    try {
+      std::size_t used = 0;
+      seed = std::stoull(args[1], &used);
+      if (used != args[1].size()) throw std::invalid_argument("seed");
+    } catch (const std::logic_error&) {
+      throw rs::Error("bad seed '" + args[1] + "': give a whole number >= 0");
+    }
+    return run_random(seed, args[3]);
   }
   syn::ScanSpec spec;
   syn::PickSpec picks;
@@ -121,6 +195,7 @@ int run(int argc, char** argv) {
     try {
       if (a == "--shape") spec.shape = syn::parse_shape(value());
       else if (a == "--background") spec.background = syn::parse_background(value());
+      else if (a == "--texture") spec.texture = syn::parse_texture(value());
       else if (a == "--triangles") spec.triangles = std::stoull(value());
       else if (a == "--step") spec.step = syn::parse_step(value());
       else if (a == "--blend-width") spec.blend_width = std::stod(value());

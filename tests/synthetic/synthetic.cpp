@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -38,7 +39,8 @@ double gaussian(std::uint64_t seed, std::uint64_t stream, std::uint64_t index) {
   const double u2 = uniform01(seed, stream, 2 * index + 1);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
-enum Stream : std::uint64_t { kJitterU = 1, kJitterV = 2, kDiagonal = 3, kNoise = 4 };
+enum Stream : std::uint64_t { kJitterU = 1, kJitterV = 2, kDiagonal = 3, kNoise = 4, kDots = 5, kPickMove = 6,
+                               kRandomDraw = 1000 };
 
 // std::hypot is careful about overflow and slow; our coordinates are small.
 inline double len2d(double x, double y) { return std::sqrt(x * x + y * y); }
@@ -70,6 +72,24 @@ double sd_duck(double x, double y) {
   return d;
 }
 constexpr double kSlotsHalfU = 24, kSlotsHalfV = 9;
+
+// Box given by its corners.
+double sd_span(double x, double y, double x0, double x1, double y0, double y1) {
+  return sd_box(x, y, 0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (x1 - x0), 0.5 * (y1 - y0));
+}
+// Block letters of half sizes X, Y and stroke width w, centred on the origin.
+double sd_letter(double x, double y, char letter, double X, double Y, double w) {
+  const double left = sd_span(x, y, -X, -X + w, -Y, Y), right = sd_span(x, y, X - w, X, -Y, Y);
+  const double top = sd_span(x, y, -X, X, Y - w, Y), bottom = sd_span(x, y, -X, X, -Y, -Y + w);
+  switch (letter) {
+    case 'L': return std::min(left, bottom);
+    case 'T': return std::min(top, sd_span(x, y, -0.5 * w, 0.5 * w, -Y, Y));
+    case 'E': return std::min({left, top, bottom, sd_span(x, y, -X, 0.6 * X, -0.5 * w, 0.5 * w)});
+    case 'H': return std::min({left, right, sd_span(x, y, -X, X, -0.5 * w, 0.5 * w)});
+    case 'U': return std::min({left, right, bottom});
+    default: return left;
+  }
+}
 constexpr double kOpenA[3] = {34, 4, 14};   // disk clipped by the right edge (needs width/2 < 48)
 constexpr double kOpenB[3] = {22, -8, 7};
 
@@ -205,6 +225,33 @@ struct ArcLength {
   }
 };
 
+// Dots texture: the centre of lattice cell (i, j)'s dot (jittered by up to a quarter period).
+Vec2 dot_center(const ScanSpec& sp, std::int64_t i, std::int64_t j) {
+  const double S = sp.texture_period * sp.h;
+  const std::uint64_t key = static_cast<std::uint64_t>(i + (1 << 20)) * 2097152ULL + static_cast<std::uint64_t>(j + (1 << 20));
+  return Vec2((i + 0.5 + 0.5 * (uniform01(sp.seed, kDots, 2 * key) - 0.5)) * S,
+              (j + 0.5 + 0.5 * (uniform01(sp.seed, kDots, 2 * key + 1) - 0.5)) * S);
+}
+// Texture offset along the normal at (u, v), absolute units.
+double texture_at(const ScanSpec& sp, double u, double v) {
+  const double A = sp.texture_amplitude * sp.h, P = sp.texture_period * sp.h;
+  if (sp.texture == Texture::Striations)
+    return A * std::sin(2 * M_PI * (u * std::cos(sp.texture_angle) + v * std::sin(sp.texture_angle)) / P);
+  if (sp.texture == Texture::Dots) {
+    const std::int64_t ci = static_cast<std::int64_t>(std::floor(u / P)), cj = static_cast<std::int64_t>(std::floor(v / P));
+    const double r = sp.dot_radius * sp.h;
+    double best = 0;
+    for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
+      for (std::int64_t i = ci - 1; i <= ci + 1; ++i) {
+        const Vec2 c = dot_center(sp, i, j);
+        const double dist = len2d(u - c.x(), v - c.y());
+        if (dist < r) best = std::max(best, smoothstep(1 - dist / r));
+      }
+    return A * best;
+  }
+  return 0;
+}
+
 }  // namespace
 
 // --- enums -------------------------------------------------------------------------------
@@ -214,14 +261,22 @@ Shape parse_shape(const std::string& n) {
   if (n == "rectangle") return Shape::Rectangle;
   if (n == "slots") return Shape::Slots;
   if (n == "open") return Shape::Open;
-  throw Error("unknown shape '" + n + "': use duck, disk, rectangle, slots or open");
+  if (n == "gear") return Shape::Gear;
+  if (n == "c") return Shape::CShape;
+  if (n == "ellipse") return Shape::Ellipse;
+  if (n == "rounded-box") return Shape::RoundedBox;
+  if (n == "letter") return Shape::Letter;
+  if (n == "band") return Shape::Band;
+  throw Error("unknown shape '" + n + "': use duck, disk, rectangle, slots, open, gear, c, ellipse, rounded-box, letter or band");
 }
 Background parse_background(const std::string& n) {
   if (n == "plane") return Background::Plane;
   if (n == "cylinder") return Background::Cylinder;
   if (n == "sphere") return Background::Sphere;
   if (n == "saddle") return Background::Saddle;
-  throw Error("unknown background '" + n + "': use plane, cylinder, sphere or saddle");
+  if (n == "vase") return Background::Vase;
+  if (n == "wavy") return Background::Wavy;
+  throw Error("unknown background '" + n + "': use plane, cylinder, sphere, saddle, vase or wavy");
 }
 Step parse_step(const std::string& n) {
   if (n == "sharp") return Step::Sharp;
@@ -241,6 +296,12 @@ const char* to_string(Shape s) {
     case Shape::Rectangle: return "rectangle";
     case Shape::Slots: return "slots";
     case Shape::Open: return "open";
+    case Shape::Gear: return "gear";
+    case Shape::CShape: return "c";
+    case Shape::Ellipse: return "ellipse";
+    case Shape::RoundedBox: return "rounded-box";
+    case Shape::Letter: return "letter";
+    case Shape::Band: return "band";
   }
   return "?";
 }
@@ -250,10 +311,26 @@ const char* to_string(Background b) {
     case Background::Cylinder: return "cylinder";
     case Background::Sphere: return "sphere";
     case Background::Saddle: return "saddle";
+    case Background::Vase: return "vase";
+    case Background::Wavy: return "wavy";
   }
   return "?";
 }
 const char* to_string(Step s) { return s == Step::Sharp ? "sharp" : "blended"; }
+Texture parse_texture(const std::string& n) {
+  if (n == "none") return Texture::None;
+  if (n == "striations") return Texture::Striations;
+  if (n == "dots") return Texture::Dots;
+  throw Error("unknown texture '" + n + "': use none, striations or dots");
+}
+const char* to_string(Texture t) {
+  switch (t) {
+    case Texture::None: return "none";
+    case Texture::Striations: return "striations";
+    case Texture::Dots: return "dots";
+  }
+  return "?";
+}
 const char* to_string(Start s) {
   switch (s) {
     case Start::Near: return "near";
@@ -265,6 +342,13 @@ const char* to_string(Start s) {
 
 // --- geometry of a scan ------------------------------------------------------------------
 double Scan::signed_distance(double u, double v) const {
+  if (spec.shape_rotation != 0 || spec.shape_center_u != 0 || spec.shape_center_v != 0) {
+    // Into the shape's own frame (a rigid motion keeps distances).
+    const double c = std::cos(spec.shape_rotation), s = std::sin(spec.shape_rotation);
+    const double x = u - spec.shape_center_u, y = v - spec.shape_center_v;
+    u = c * x + s * y;
+    v = -s * x + c * y;
+  }
   switch (spec.shape) {
     case Shape::Duck: return sd_duck(u, v);
     case Shape::Disk: return sd_circle(u, v, 0, 0, 12);
@@ -281,6 +365,39 @@ double Scan::signed_distance(double u, double v) const {
     }
     case Shape::Open:
       return std::min(sd_circle(u, v, kOpenA[0], kOpenA[1], kOpenA[2]), sd_circle(u, v, kOpenB[0], kOpenB[1], kOpenB[2]));
+    case Shape::Gear: {
+      const double R = spec.gear_radius, depth = spec.gear_slot_depth, extra = 2;
+      double d = sd_circle(u, v, 0, 0, R);
+      for (std::size_t k = 0; k + 1 < slots.size(); k += 2) {
+        const double c = std::cos(slots[k]), s = std::sin(slots[k]);
+        const double radial = c * u + s * v, across = -s * u + c * v;
+        d = std::max(d, -sd_box(radial, across, R - depth + 0.5 * (depth + extra), 0, 0.5 * (depth + extra),
+                                0.5 * slots[k + 1]));
+      }
+      return d;
+    }
+    case Shape::CShape: {
+      const double ring = std::abs(len2d(u, v) - spec.c_radius) - spec.c_half_thickness;
+      const double c = std::cos(spec.c_gap_angle), s = std::sin(spec.c_gap_angle);
+      const double radial = c * u + s * v, across = -s * u + c * v;
+      return std::max(ring, -sd_box(radial, across, spec.c_radius, 0, spec.c_half_thickness + 2, 0.5 * spec.c_gap_width));
+    }
+    case Shape::Ellipse: {
+      // min(a, b) (|(u/a, v/b)| - 1): zero on the ellipse, 1-Lipschitz, a lower bound of the distance.
+      const double a = spec.ellipse_a, b = spec.ellipse_b;
+      return std::min(a, b) * (len2d(u / a, v / b) - 1);
+    }
+    case Shape::RoundedBox: {
+      const double r = spec.box_corner;
+      return sd_box(u, v, 0, 0, spec.box_half_u - r, spec.box_half_v - r) - r;
+    }
+    case Shape::Letter: return sd_letter(u, v, spec.letter, spec.letter_half_u, spec.letter_half_v, spec.stroke_width);
+    case Shape::Band: {
+      double d = 1e300;
+      for (std::size_t k = 0; k + 3 < band.size(); k += 2)
+        d = std::min(d, sd_capsule(u, v, band[k], band[k + 1], band[k + 2], band[k + 3], spec.band_half_width));
+      return d;
+    }
   }
   return 1;
 }
@@ -299,6 +416,16 @@ Vec3 Scan::surface(double u, double v, double height) const {
       return (R + height) * n - Vec3(0, 0, R);
     }
     case Background::Saddle: return Vec3(u, v, (u * u - v * v) / (2 * R)) + height * background_normal(u, v);
+    case Background::Vase: {
+      const double a = u / R;
+      const double rho = R * (1 + spec.vase_amplitude * std::sin(2 * M_PI * v / spec.vase_period + spec.vase_phase));
+      return Vec3(rho * std::sin(a), v, rho * std::cos(a) - R) + height * background_normal(u, v);
+    }
+    case Background::Wavy: {
+      const double z = spec.wavy_amplitude * std::sin(2 * M_PI * u / spec.wavy_period_u + spec.wavy_phase) *
+                       std::cos(2 * M_PI * v / spec.wavy_period_v);
+      return Vec3(u, v, z) + height * background_normal(u, v);
+    }
   }
   return Vec3(u, v, height);
 }
@@ -313,6 +440,19 @@ Vec3 Scan::background_normal(double u, double v) const {
       return Vec3(std::cos(b) * std::sin(a), std::sin(b), std::cos(b) * std::cos(a));
     }
     case Background::Saddle: return Vec3(-u / R, v / R, 1).normalized();
+    case Background::Vase: {
+      // d(rho)/dv; the normal is (sin a, -rho', cos a) / |.| (d/du x d/dv, facing +z at u = 0).
+      const double k = 2 * M_PI / spec.vase_period;
+      const double drho = R * spec.vase_amplitude * k * std::cos(k * v + spec.vase_phase);
+      const double a = u / R;
+      return Vec3(std::sin(a), -drho, std::cos(a)).normalized();
+    }
+    case Background::Wavy: {
+      const double ku = 2 * M_PI / spec.wavy_period_u, kv = 2 * M_PI / spec.wavy_period_v, A = spec.wavy_amplitude;
+      const double fu = A * ku * std::cos(ku * u + spec.wavy_phase) * std::cos(kv * v);
+      const double fv = -A * kv * std::sin(ku * u + spec.wavy_phase) * std::sin(kv * v);
+      return Vec3(-fu, -fv, 1).normalized();
+    }
   }
   return Vec3(0, 0, 1);
 }
@@ -360,7 +500,17 @@ Scan generate(const ScanSpec& spec) {
     if ((spec.background == Background::Cylinder && a >= M_PI * 0.9) ||
         (spec.background == Background::Sphere && (a >= M_PI * 0.9 || b >= M_PI / 2 * 0.9)))
       throw Error("synthetic scan: the domain wraps too far around the background; use a larger radius");
+    if (spec.background == Background::Vase && (a >= M_PI * 0.9 || !(std::abs(spec.vase_amplitude) < 0.5) ||
+                                                !(spec.vase_period > 0)))
+      throw Error("synthetic scan: the vase needs a larger radius, |amplitude| < 0.5 and a period > 0");
+    if (spec.background == Background::Wavy && !(spec.wavy_period_u > 0 && spec.wavy_period_v > 0))
+      throw Error("synthetic scan: the wavy background needs periods > 0");
   }
+  if (spec.texture != Texture::None &&
+      !(spec.texture_period > 0 && spec.dot_radius > 0 && std::abs(spec.texture_amplitude) <= 1))
+    throw Error("synthetic scan: the texture needs a period > 0, a dot radius > 0 and |amplitude| <= 1");
+  if (!(spec.grade_u >= 0 && spec.grade_u < 0.9 && spec.grade_v >= 0 && spec.grade_v < 0.9))
+    throw Error("synthetic scan: grade_u and grade_v must be in [0, 0.9)");
   if (spec.shape == Shape::Open && 0.5 * spec.width >= kOpenA[0] + kOpenA[2])
     throw Error("synthetic scan: the open shape needs width < 96 to be clipped by the domain edge");
 
@@ -393,6 +543,37 @@ Scan generate(const ScanSpec& spec) {
       s.UV[2 * k] = -0.5 * W + i * s.spacing_u + du;
       s.UV[2 * k + 1] = -0.5 * H + j * s.spacing_v + dv;
     }
+  if (spec.grade_u > 0 || spec.grade_v > 0) {
+    // Graded triangulation: a monotone warp of each axis that keeps the domain's edges, so the
+    // spacing varies by (1 +- grade) and no triangle flips.
+    auto warp = [](double x, double L, double g) { return x - g * L / (2 * M_PI) * std::sin(2 * M_PI * x / L); };
+    for (std::size_t k = 0; k < nv; ++k) {
+      if (spec.grade_u > 0) s.UV[2 * k] = warp(s.UV[2 * k] + 0.5 * W, W, spec.grade_u) - 0.5 * W;
+      if (spec.grade_v > 0) s.UV[2 * k + 1] = warp(s.UV[2 * k + 1] + 0.5 * H, H, spec.grade_v) - 0.5 * H;
+    }
+  }
+  if (spec.shape == Shape::Band) {
+    // Centreline: starts outside the domain edge, enters along the edge's inward normal turned by
+    // band_angle, bends with band_curvature.
+    const double margin = 2 * spec.band_half_width + 4;
+    Vec2 p, n;
+    switch (spec.band_edge) {
+      case 0: p = Vec2(-0.5 * W - margin, spec.band_offset), n = Vec2(1, 0); break;
+      case 1: p = Vec2(0.5 * W + margin, spec.band_offset), n = Vec2(-1, 0); break;
+      case 2: p = Vec2(spec.band_offset, -0.5 * H - margin), n = Vec2(0, 1); break;
+      default: p = Vec2(spec.band_offset, 0.5 * H + margin), n = Vec2(0, -1); break;
+    }
+    double angle = std::atan2(n.y(), n.x()) + spec.band_angle;
+    const int pieces = 32;
+    const double length = spec.band_length + margin, step = length / pieces;
+    s.band.push_back(p.x()), s.band.push_back(p.y());
+    for (int k = 0; k < pieces; ++k) {
+      angle += 0.5 * spec.band_curvature * step;
+      p += step * Vec2(std::cos(angle), std::sin(angle));
+      angle += 0.5 * spec.band_curvature * step;
+      s.band.push_back(p.x()), s.band.push_back(p.y());
+    }
+  }
 
   // Random diagonals; also the unique edges (horizontal, vertical, one diagonal per quad).
   s.F.resize(static_cast<std::size_t>(6) * cells_u * cells_v);
@@ -450,27 +631,67 @@ Scan generate(const ScanSpec& spec) {
     }
   }
 
+  if (spec.shape == Shape::Gear) {
+    // Radial slots, evenly spaced, mouths in nominal average edges.
+    const std::size_t n = spec.slot_widths.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double width = spec.slot_widths[k] * s.nominal_edge;
+      if (!(width > 0)) throw Error("synthetic scan: slot widths must be > 0 (in average edges)");
+      if (2 * M_PI * spec.gear_radius / n - width < 1.5 * spec.h)
+        throw Error("synthetic scan: the gear's slots do not fit; use fewer or narrower slots");
+      s.slots.push_back(2 * M_PI * static_cast<double>(k) / n);
+      s.slots.push_back(width);
+    }
+    if (!(spec.gear_slot_depth > 0 && spec.gear_slot_depth < spec.gear_radius - 2 * spec.h))
+      throw Error("synthetic scan: the gear's slot depth must be in (0, radius - 2 h)");
+  }
+
   // Heights along the normal, flags, noise.
   s.V.resize(3 * nv);
   s.relief.resize(nv);
+  s.relief_height.resize(nv);
+  s.texture_height.assign(nv, 0.0);
+  s.noise_height.assign(nv, 0.0);
   const double h = spec.h;
   for (std::size_t k = 0; k < nv; ++k) {
     const double u = s.UV[2 * k], v = s.UV[2 * k + 1];
     const double sd = s.signed_distance(u, v);
     s.relief[k] = sd < 0;
-    double height = 0;
+    double height = 0, rise = 0;
     if (sd < 0) {
       const double d = -sd;
-      const double rise = spec.step == Step::Sharp ? 1.0 : smoothstep(d / (spec.blend_width * h));
+      rise = spec.step == Step::Sharp ? 1.0 : smoothstep(d / (spec.blend_width * h));
       const double top = spec.drop ? 1.0 - 0.7 * smoothstep(d / (1.5 * h)) : 1.0;
       height = h * rise * top;
       if (spec.detail > 0) {
         const double wave = 4 * h;
-        height += spec.detail * h * smoothstep((d - 2 * h) / h) * std::sin(2 * M_PI * u / wave) *
+        height += spec.detail * h * smoothstep((d - spec.bump_inset * h) / h) * std::sin(2 * M_PI * u / wave) *
                   std::sin(2 * M_PI * v / wave);
       }
+      if (spec.dome > 0) height += spec.dome * h * smoothstep(d / (spec.dome_width * h));
+      if (spec.grooves > 0) {
+        // Parallel straight grooves across the relief, faded out within 1 h of its edge.
+        const double across = u * std::cos(spec.groove_angle) + v * std::sin(spec.groove_angle);
+        const double off = std::remainder(across, spec.groove_spacing * h) / (spec.groove_width * h);
+        height -= spec.grooves * h * std::exp(-off * off) * smoothstep((d - 0.5 * h) / (0.5 * h));
+      }
+      if (spec.edge_groove > 0) {
+        const double off = (d - spec.edge_groove_distance * h) / (spec.groove_width * h);
+        height -= spec.edge_groove * h * std::exp(-off * off);
+      }
     }
-    if (spec.noise > 0) height += spec.noise * h * gaussian(spec.seed, kNoise, k);
+    s.relief_height[k] = height;
+    if (spec.texture != Texture::None) {
+      // The background's texture, fading out as the step rises.
+      const double t = texture_at(spec, u, v) * (sd < 0 ? 1 - rise : 1.0);
+      s.texture_height[k] = t;
+      if (t != 0) height += t;
+    }
+    if (spec.noise > 0) {
+      const double e = spec.noise * h * gaussian(spec.seed, kNoise, k);
+      s.noise_height[k] = e;
+      height += e;
+    }
     const Vec3 p = s.surface(u, v, height);
     s.V[3 * k] = p.x(), s.V[3 * k + 1] = p.y(), s.V[3 * k + 2] = p.z();
   }
@@ -632,6 +853,31 @@ Picks Scan::picks(const PickSpec& ps) const {
   return out;
 }
 
+std::int64_t texture_feature_vertex(const Scan& scan, double u, double v) {
+  const ScanSpec& sp = scan.spec;
+  const double P = sp.texture_period * sp.h;
+  if (sp.texture == Texture::Dots) {
+    const std::int64_t ci = static_cast<std::int64_t>(std::floor(u / P)), cj = static_cast<std::int64_t>(std::floor(v / P));
+    Vec2 best(u, v);
+    double best_d = 1e300;
+    for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
+      for (std::int64_t i = ci - 1; i <= ci + 1; ++i) {
+        const Vec2 c = dot_center(sp, i, j);
+        const double d = len2d(u - c.x(), v - c.y());
+        if (d < best_d) best_d = d, best = c;
+      }
+    return scan.nearest_vertex(best.x(), best.y());
+  }
+  if (sp.texture == Texture::Striations) {
+    // Crests where the phase is a quarter period; move across the ridges to the nearest one.
+    const Vec2 dir(std::cos(sp.texture_angle), std::sin(sp.texture_angle));
+    const double s = u * dir.x() + v * dir.y();
+    const double crest = P * (std::round(s / P - 0.25) + 0.25);
+    return scan.nearest_vertex(u + (crest - s) * dir.x(), v + (crest - s) * dir.y());
+  }
+  return -1;
+}
+
 // --- scoring -----------------------------------------------------------------------------
 namespace {
 double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
@@ -714,6 +960,26 @@ double PolylineDistance::operator()(const Vec3& p) const {
   // Far from the polylines: brute force.
   for (const auto& s : segments_) best = std::min(best, point_segment(p, s.first, s.second));
   return best;
+}
+
+bool PolylineDistance::within(const Vec3& p, double r) const {
+  if (segments_.empty()) return false;
+  const Vec3 c = (p - origin_) / cell_;
+  const std::int64_t limit = (1LL << kBits) - 1;
+  const std::int64_t reach = static_cast<std::int64_t>(std::ceil(r / cell_));
+  const std::int64_t cx = static_cast<std::int64_t>(std::floor(c.x()));
+  const std::int64_t cy = static_cast<std::int64_t>(std::floor(c.y()));
+  const std::int64_t cz = static_cast<std::int64_t>(std::floor(c.z()));
+  for (std::int64_t x = std::max<std::int64_t>(0, cx - reach); x <= std::min(limit, cx + reach); ++x)
+    for (std::int64_t y = std::max<std::int64_t>(0, cy - reach); y <= std::min(limit, cy + reach); ++y)
+      for (std::int64_t z = std::max<std::int64_t>(0, cz - reach); z <= std::min(limit, cz + reach); ++z) {
+        auto range = std::equal_range(keys_.begin(), keys_.end(), pack(x, y, z));
+        for (auto it = range.first; it != range.second; ++it) {
+          const auto& s = segments_[entries_[it - keys_.begin()]];
+          if (point_segment(p, s.first, s.second) <= r) return true;
+        }
+      }
+  return false;
 }
 
 std::vector<Vec3> resample(const Polyline& polyline, double step) {
@@ -821,6 +1087,25 @@ void write_obj(const Scan& scan, const std::string& path) {
 }
 
 void write_truth_json(const Scan& scan, const Picks& picks, const std::string& path) {
+  const nlohmann::json j = truth_json(scan, picks);
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write " + path + ": check that the folder exists and is writable");
+  out << j.dump() << "\n";
+  if (!out) throw Error("failed writing " + path + ": check free disk space");
+}
+
+void write_json(const nlohmann::json& j, const std::string& path) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw Error("cannot write " + tmp + ": check that the folder exists and is writable");
+    out << j.dump() << "\n";
+    if (!out) throw Error("failed writing " + tmp + ": check free disk space");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error("cannot rename " + tmp + " to " + path);
+}
+
+nlohmann::json truth_json(const Scan& scan, const Picks& picks) {
   nlohmann::json j;
   const ScanSpec& sp = scan.spec;
   j["h"] = scan.h;
@@ -873,10 +1158,7 @@ void write_truth_json(const Scan& scan, const Picks& picks, const std::string& p
                {"drop", sp.drop},                   {"noise", sp.noise},
                {"jitter", sp.jitter},               {"slot_widths", sp.slot_widths},
                {"slot_depth", sp.slot_depth},       {"seed", sp.seed}};
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write " + path + ": check that the folder exists and is writable");
-  out << j.dump() << "\n";
-  if (!out) throw Error("failed writing " + path + ": check free disk space");
+  return j;
 }
 
 }  // namespace synthetic
