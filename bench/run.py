@@ -14,7 +14,7 @@ import threading
 import time
 from pathlib import Path
 
-from .cases import Scan
+from .cases import PAPER_W_INT, Scan
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -140,6 +140,8 @@ class Runner:
         out = self.work / f"result-{tag}.json"
         cmd = [str(self.cli), "segment", f"{scan.prefix}.ply", "--picks", ",".join(map(str, truth["picks"])),
                "--step-height", repr(h_factor * truth["h"]), "--out", str(out)]
+        if w_int is None and "refit_step_height=0" in options:
+            w_int = PAPER_W_INT  # the paper's method, or a variant of it: the paper's W_int too
         if w_int is not None:
             cmd += ["--w-int", repr(w_int)]
         if not truth.get("picks_closed", True):

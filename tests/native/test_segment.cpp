@@ -45,13 +45,15 @@ TEST_P(SegmentScan, FindsTheReliefBoundary) {
   const syn::Picks picks = scan.picks(pick_spec);
 
   Options options;
-  options.step_height = c.h_factor * scan.h;
+  options.step_height = c.h_factor * scan.h;  // h_factor 0: kAuto, the engine estimates h
   options.closed = picks.closed;
   options.relief_side = picks.relief_side;
   if (c.tweak) c.tweak(options);
   const Result result = segment(mesh, picks.vertices, options);
 
-  EXPECT_EQ(result.status, Status::Converged);
+  EXPECT_EQ(result.status, Status::Converged) << result.message;
+  if (c.h_factor == 0) EXPECT_NEAR(result.parameters.step_height, scan.h, 0.25 * scan.h);
+  if (options.relief_side == ReliefSide::Auto) EXPECT_EQ(result.relief_side, picks.relief_side);
   ASSERT_GE(result.polyline.size(), 10u);
   syn::Polyline contour;
   contour.points = result.polyline;
@@ -132,6 +134,29 @@ std::vector<Case> cases() {
   foot.h_factor = 0.6;
   foot.tweak = [](Options& o) { o.foot_snap = true; };
   out.push_back(foot);
+  // Issue 14: what the paper's method got wrong and called converged. A sharp duck on a
+  // cylinder with h typed x0.6 collapsed onto 29 vertices inside the relief; the step found
+  // along the contour now refits h.
+  Case low_sharp = make("duck_sharp_cylinder_h_x0.6", syn::Shape::Duck, syn::Step::Sharp);
+  low_sharp.background = syn::Background::Cylinder;
+  low_sharp.triangles = 76000;
+  low_sharp.h_factor = 0.6;
+  out.push_back(low_sharp);
+  Case typed_high = make("duck_blended_h_x2", syn::Shape::Duck, syn::Step::Blended);
+  typed_high.triangles = 100000;
+  typed_high.h_factor = 2.0;
+  out.push_back(typed_high);
+  // No h at all: estimated from the picks and the surface.
+  Case auto_h = make("duck_h_auto", syn::Shape::Duck, syn::Step::Blended);
+  auto_h.triangles = 100000;
+  auto_h.background = syn::Background::Sphere;
+  auto_h.h_factor = 0;
+  out.push_back(auto_h);
+  // An open contour whose side is not given: the side that rises.
+  Case open_auto = make("open_relief_side_auto", syn::Shape::Open, syn::Step::Blended);
+  open_auto.h_factor = 0;
+  open_auto.tweak = [](Options& o) { o.relief_side = ReliefSide::Auto; };
+  out.push_back(open_auto);
   return out;
 }
 

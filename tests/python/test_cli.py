@@ -84,7 +84,8 @@ def test_info_reports_the_mesh(cli, grid_obj):
         (["segment", "{mesh}", "--picks", "0,1,4", "--step-height", "-1"], 2, ["> 0"]),
         (["segment", "{mesh}", "--picks", "0,1,4", "--step-height", "nan"], 2, ["finite number"]),
         (["segment", "{mesh}", "--picks", "0,1,4", "--step-height", "abc"], 2, ["'abc'"]),
-        (["segment", "{mesh}", "--picks", "0,1,4"], 2, ["--step-height"]),
+        # No h: estimated; a flat grid has no relief to estimate it from.
+        (["segment", "{mesh}", "--picks", "0,1,4", "--quiet"], 1, ["step height", "give h"]),
         (["segment", "{mesh}", "--step-height", "1"], 2, ["--picks"]),
         (["segment", "{mesh}", "--picks", "0,1,4", "--step-height", "1", "--bogus"], 2, ["--bogus"]),
         (["segment", "{mesh}", "--picks", "0,1,4", "--step-height", "1", "--relief-side", "left"], 2, ["--open"]),
@@ -134,18 +135,23 @@ def test_segment_synthetic_scan(cli, build_dir, tmp_path):
     result = json.loads(out.read_text())
 
     # Schema.
-    for key in ["status", "closed", "contour", "relief_vertices", "phases", "parameters", "mesh",
-                "planarity_vertices", "notes", "timing"]:
+    for key in ["format", "status", "message", "reasons", "closed", "contour", "relief_vertices", "step_height",
+                "w_int", "checks", "attempts", "phases", "parameters", "mesh", "planarity_vertices", "notes",
+                "timing"]:
         assert key in result, key
-    assert result["status"] in ("converged", "iteration_cap")
+    # The true h on a clean scan: the self-check holds, so the status is converged and exit code 0.
+    assert result["status"] == "converged" and result["message"] == "" and result["reasons"] == []
+    assert result["checks"]["step_share"] >= 0.9
     assert result["closed"] is True
     assert len(result["contour"]) >= 3 and all(len(p) == 3 for p in result["contour"])
     assert [p["name"] for p in result["phases"]][-3:] == ["coarse", "refine", "stabilise"]
     for phase in result["phases"]:
         assert set(phase) == {"name", "iterations", "snaxels", "seconds", "converged"}
     params = result["parameters"]
-    assert params["step_height"] == truth["h"] and params["picks"] == truth["picks"]
-    assert params["open"] is False and params["w_int"] == 0.25 and params["max_iterations"] == 3000
+    assert result["step_height"]["given"] == truth["h"] and params["picks"] == truth["picks"]
+    assert result["step_height"]["used"] == params["step_height"]
+    assert result["w_int"]["given"] is None and result["w_int"]["used"] in (0.25, 0.5, 1.0)
+    assert params["open"] is False and params["w_int"] == result["w_int"]["used"] and params["max_iterations"] == 3000
     for key in ["coarse_spacing", "refine_spacing", "alpha_coarse", "beta_coarse", "alpha_refine", "beta_refine",
                 "gamma", "sigma_background", "sigma_s", "w_f", "w_d", "average_edge"]:
         assert key in params, key
@@ -256,7 +262,10 @@ def test_advanced_options_reach_the_engine_and_the_report(cli, build_dir, tmp_pa
             "--max-iterations", "20", "--option", "remove_loops=false", "--option", "scale_feature_with_spacing=0",
             "--option", "planarity_one_ring=0",
             timeout=300)
-    assert r.returncode == 0, r.stderr[-2000:]
-    params = json.loads(out.read_text())["parameters"]
+    # 20 iterations stop at the cap: the result is written, with exit code 3 and the reason.
+    assert r.returncode == 3, r.stderr[-2000:]
+    off = json.loads(out.read_text())
+    assert off["status"] == "iteration_cap" and "iteration cap" in off["message"]
+    params = off["parameters"]
     assert params["remove_loops"] is False and params["scale_feature_with_spacing"] is False
     assert params["planarity_one_ring"] is False

@@ -394,9 +394,12 @@ def disk_result(scan):
 def test_result_dict_structure(scan, disk_result):
     V, _, _, _, h, _ = scan
     r = disk_result
-    assert set(r) == {"status", "closed", "contour", "relief_vertices", "phases", "parameters",
-                      "planarity_vertices", "notes", "mesh_report", "seconds"}
-    assert r["status"] in ("converged", "iteration_cap")
+    # The same document the CLI writes (docs/result-format.md).
+    assert set(r) == {"format", "status", "message", "reasons", "closed", "relief_side", "contour",
+                      "relief_vertices", "step_height", "w_int", "checks", "attempts", "phases", "parameters",
+                      "notes", "planarity_vertices", "mesh", "timing"}
+    assert r["format"] == "relief-snake-result/1"
+    assert r["status"] == "converged" and r["reasons"] == [] and r["relief_side"] is None
     assert r["closed"] is True
     assert len(r["contour"]) >= 3
     assert all(isinstance(p, tuple) and len(p) == 3 and all(isinstance(x, float) for x in p) for p in r["contour"])
@@ -410,12 +413,14 @@ def test_result_dict_structure(scan, disk_result):
                 "gamma", "sigma_background", "sigma_s", "w_int", "w_f", "w_d", "average_edge", "step_height",
                 "open", "relief_side", "max_iterations"]:
         assert key in params, key
-    assert params["step_height"] == h and params["w_int"] == 0.25 and params["open"] is False
+    assert r["step_height"]["given"] == h and params["step_height"] == r["step_height"]["used"]
+    assert r["w_int"]["given"] is None and params["w_int"] == r["w_int"]["used"] and params["open"] is False
     assert params["relief_side"] == "left" and params["max_iterations"] == 3000
     assert isinstance(r["planarity_vertices"], int) and r["planarity_vertices"] > 0
     assert all(isinstance(n, str) for n in r["notes"])
-    assert r["mesh_report"] == core.mesh_report(*scan[:2])
-    assert r["seconds"] > 0 and r["seconds"] >= sum(p["seconds"] for p in r["phases"]) * 0.99
+    assert r["mesh"]["summary"] == core.mesh_report(*scan[:2])
+    t = r["timing"]
+    assert t["segment_seconds"] > 0 and t["segment_seconds"] >= sum(p["seconds"] for p in r["phases"]) * 0.99
 
 
 def test_disk_relief_is_found(scan, disk_result):
