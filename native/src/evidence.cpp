@@ -66,7 +66,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
 
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
   std::vector<double> heights;
-  std::vector<int> outside;
+  std::vector<int> outside, near_outside;
   for (int k = 0; k < count; ++k) {
     const int i = static_cast<int>((static_cast<long long>(k) * n) / count);
     ++evidence.attempted;
@@ -76,6 +76,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
 
     // The background plane: area-weighted least squares over the outside vertices.
     outside.clear();
+    near_outside.clear();
     double weight = 0;
     Vec3 mean = Vec3::Zero(), normal_sum = Vec3::Zero();
     int inside_count = 0;
@@ -84,7 +85,10 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
         ++inside_count;
         continue;
       }
-      if ((mesh.position(v) - centre).squaredNorm() < exclude2) continue;
+      if ((mesh.position(v) - centre).squaredNorm() < exclude2) {
+        near_outside.push_back(v);
+        continue;
+      }
       outside.push_back(v);
       const double a = mesh.vertex_area(v);
       weight += a;
@@ -113,16 +117,22 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     profile.rise = quantile(heights, options.rise_quantile);
     profile.residual = residual;
     profile.on_step = profile.rise > std::max(options.min_rise * h, options.residual_factor * residual);
+    heights.clear();
+    for (const int v : near_outside) heights.push_back((mesh.position(v) - mean).dot(normal));
+    profile.foot = quantile(heights, 0.5);
+    profile.at_foot = heights.empty() || profile.foot < options.max_foot * profile.rise;
     evidence.profiles.push_back(profile);
   }
 
   if (evidence.profiles.empty()) return evidence;
   std::vector<double> rises, step_rises, residuals;
+  int at_foot = 0;
   for (const StepProfile& p : evidence.profiles) {
     rises.push_back(p.rise);
     residuals.push_back(p.residual);
-    if (p.on_step) step_rises.push_back(p.rise);
+    if (p.on_step) step_rises.push_back(p.rise), at_foot += p.at_foot ? 1 : 0;
   }
+  evidence.foot_share = step_rises.empty() ? 1.0 : double(at_foot) / step_rises.size();
   evidence.step_share = double(step_rises.size()) / evidence.profiles.size();
   evidence.rise_median = quantile(rises, 0.5);
   evidence.background_residual = quantile(residuals, 0.5);
@@ -146,12 +156,20 @@ std::string number(double x) {
 }
 }  // namespace
 
-double enclosed_area(const std::vector<Vec3>& polyline) {
+Vec3 vector_area(const std::vector<Vec3>& polyline) {
   Vec3 area = Vec3::Zero();
   const std::size_t n = polyline.size();
   for (std::size_t i = 0; i < n; ++i)
     area += (polyline[i] - polyline[0]).cross(polyline[(i + 1) % n] - polyline[0]);
-  return 0.5 * area.norm();
+  return 0.5 * area;
+}
+
+Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region) {
+  Vec3 area = Vec3::Zero();
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    if (region[mesh.face_vertex(f, 0)] && region[mesh.face_vertex(f, 1)] && region[mesh.face_vertex(f, 2)])
+      area += mesh.face_area(f) * mesh.face_normal(f);
+  return area;
 }
 
 SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options) {
@@ -165,6 +183,9 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("only " + percent(evidence.step_share) +
                             " of the contour runs along a step: it may have crossed into the relief or stopped "
                             "on detail or texture");
+  if (evidence.step_share >= options.min_step_share && evidence.foot_share < options.min_foot_share)
+    check.reasons.push_back("only " + percent(evidence.foot_share) +
+                            " of the contour sits at the foot of the step; the rest runs partway up it");
   // A coarse contour that sat on a step and a refinement that left it far behind: the
   // deflation carried the snake across the step. (A coarse contour still on the
   // background, from picks far out, may rightly be left behind.)
@@ -173,7 +194,8 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
                             ": refinement moved far from where the step was first found");
   if (all.area_ratio > options.max_area_ratio || all.area_ratio * options.max_area_ratio < 1)
     check.reasons.push_back("the relief region covers " + number(all.area_ratio) +
-                            " times the area the contour encloses: the contour may cross itself");
+                            " times the area the contour encloses: the region leaked past the contour or lost a "
+                            "piece (the contour may cross itself)");
   if (all.other_side_share > evidence.step_share)
     check.reasons.push_back("the step looks clearer from the other side of the contour: the relief side may be "
                             "wrong (give it)");

@@ -310,8 +310,17 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       if (options.closed) {
         std::vector<Vec3> polyline;
         for (const SurfacePoint& p : a.run.contour) polyline.push_back(position(mesh, p));
-        const double enclosed = enclosed_area(polyline);
-        a.evidence.area_ratio = enclosed > 0 ? region_area(mesh, a.region) / enclosed : 0.0;
+        const Vec3 enclosed = vector_area(polyline);
+        const double norm2 = enclosed.squaredNorm();
+        // The region's faces stop half a triangle short of the contour: add that strip back
+        // (perimeter x half an edge) so fine and coarse meshes compare alike.
+        double perimeter = 0;
+        for (std::size_t k = 0; k < polyline.size(); ++k) perimeter += (polyline[(k + 1) % polyline.size()] - polyline[k]).norm();
+        const double strip = 0.5 * perimeter * mesh.average_edge_length();
+        a.evidence.area_ratio =
+            norm2 > 0 ? (std::fabs(region_vector_area(mesh, a.region).dot(enclosed)) / std::sqrt(norm2) + strip) /
+                            std::sqrt(norm2)
+                      : 0.0;
       } else if (!side_given) {
         const std::vector<char> other = relief_region(mesh, a.run.contour, false, !inside_left);
         a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try).step_share;
@@ -398,6 +407,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"step_height", step.step_height},
                    {"rise_median", step.rise_median},
                    {"step_spread", step.step_spread},
+                   {"foot_share", step.foot_share},
                    {"background_residual", step.background_residual},
                    {"measured_share", step.measured_share()},
                    {"coarse_step_share", best.evidence.coarse_step_share},

@@ -29,6 +29,7 @@ struct EvidenceOptions {
   double rise_quantile = 0.75;  ///< the rise of a profile: this quantile of the inside heights
   double min_rise = 0.3;        ///< a profile is on a step if its rise exceeds min_rise h ...
   double residual_factor = 3;   ///< ... and residual_factor times the outside fit's RMS residual
+  double max_foot = 0.35;       ///< at the foot: the surface just outside rises less than this share of the rise
   int max_profiles = 240;       ///< contour points measured (evenly spread)
   int min_side_vertices = 6;    ///< fewer inside or outside vertices in the ball: not measured
 };
@@ -38,13 +39,16 @@ struct StepProfile {
   int contour_index = -1;
   double rise = 0;      ///< the inside's height above the outside plane (rise_quantile of the heights)
   double residual = 0;  ///< RMS residual of the outside plane fit
+  double foot = 0;      ///< median height above the plane of the outside vertices right at the point
   bool on_step = false;
+  bool at_foot = true;  ///< the surface just outside is background: the contour is not up the step
 };
 
 struct StepEvidence {
   std::vector<StepProfile> profiles;  ///< the measured points (those with enough vertices on both sides)
   int attempted = 0;                  ///< contour points looked at
   double step_share = 0;              ///< share of measured profiles on a step (0 if none measured)
+  double foot_share = 1;              ///< share of the on-step profiles that sit at the step's foot
   double step_height = 0;             ///< median rise of the profiles on a step: the step height found
   double rise_median = 0;             ///< median rise of all measured profiles
   double step_spread = 0;             ///< (q75 - q25) / median of the on-step rises: how even the step is
@@ -65,9 +69,11 @@ struct SelfCheckOptions {
   double min_measured_share = 0.3;  ///< below this the step could not be checked at all
   double min_coarse_iou = 0.6;    ///< overlap of the final region with the coarse phase's
   double max_step_ratio = 2.0;    ///< the step found and h may differ by at most this factor
-  /// Closed contours: the region's area against the area the contour encloses (its vector
-  /// area); outside [1 / max_area_ratio, max_area_ratio] the region leaked or lost a piece.
-  double max_area_ratio = 1.35;
+  double min_foot_share = 0.8;    ///< share of the on-step contour that must sit at the step's foot
+  /// Closed contours: the region's vector area along the contour's, against the contour's own
+  /// (the vector area of any surface a curve bounds is the same, walls and curvature included);
+  /// outside [1 / max_area_ratio, max_area_ratio] the region leaked or lost a piece.
+  double max_area_ratio = 1.25;
 };
 
 /// Everything the self-check looks at for one contour.
@@ -75,7 +81,7 @@ struct ContourEvidence {
   StepEvidence step;            ///< along the final contour
   double coarse_step_share = 0; ///< the coarse contour's share on a step
   double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
-  double area_ratio = 1;        ///< region area / enclosed (vector) area; 1 for open contours
+  double area_ratio = 1;        ///< closed contours: the region's vector area against the contour's (1: they agree)
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
 };
 
@@ -89,8 +95,11 @@ struct SelfCheck {
 /// Judges a contour's evidence; h: the step height used.
 SelfCheck judge(const ContourEvidence& evidence, double h, const SelfCheckOptions& options = {});
 
-/// Magnitude of the vector area of a closed polyline: the area it encloses on a gently curved surface.
-double enclosed_area(const std::vector<Vec3>& closed_polyline);
+/// Vector area of a closed polyline (half the sum of p_i x p_i+1): the vector area of any
+/// surface it bounds.
+Vec3 vector_area(const std::vector<Vec3>& closed_polyline);
+/// Vector area of the faces whose corners are all in the region (#V flags).
+Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region);
 
 /// Area (sum of vertex areas) of the flagged vertices.
 double region_area(const Mesh& mesh, const std::vector<char>& region);
