@@ -400,6 +400,16 @@ Mesh Mesh::build(const Input& in, const IntakeOptions& options) {
   }
 
   // --- flat arrays -----------------------------------------------------------
+  if (options.local_origin) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t i = 0; i < nv; ++i)
+      if (mesh_id[rep[i]] >= 0) {
+        const Vec3 p(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    mesh.origin_ = 0.5 * (lo + hi);
+  }
   const int n_mesh_vertices = static_cast<int>(om.n_vertices());
   mesh.input_to_mesh_.resize(nv);
   mesh.mesh_to_input_.resize(static_cast<std::size_t>(n_mesh_vertices));
@@ -411,7 +421,7 @@ Mesh Mesh::build(const Input& in, const IntakeOptions& options) {
       ++report.unreferenced_vertices;
     } else if (rep[i] == static_cast<std::int64_t>(i)) {
       mesh.mesh_to_input_[id] = i;
-      mesh.positions_[id] = Vec3(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
+      mesh.positions_[id] = Vec3(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]) - mesh.origin_;
     }
   }
   mesh.face_vertices_.clear();

@@ -109,8 +109,9 @@ class Tokens {
     *token = s_.substr(b, i_ - b);
     return true;
   }
+  /// Tokens left (from the current position).
   std::size_t count() const {
-    Tokens copy(s_);
+    Tokens copy = *this;
     std::string_view t;
     std::size_t n = 0;
     while (copy.next(&t)) ++n;

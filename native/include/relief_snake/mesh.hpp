@@ -23,6 +23,12 @@ struct IntakeOptions {
   /// and keep the readable part of a truncated or inconsistent file (MeshReport::notes says what
   /// was skipped). Off: any of these is an error that names the face, vertex or line.
   bool allow_partial = false;
+  /// Store positions relative to the bounding-box centre of the valid vertices (origin()), for
+  /// coordinates far beyond the mesh's size. At +1e6 doubles in file coordinates segment like the
+  /// scan at the origin (test_mesh_offset); this is for larger offsets, where the engine's
+  /// plane-fit moment sums (sums of squares) lose the detail. Off by default: the Segmenter does
+  /// not add origin() back to its 3D results yet, so a caller that sets it must do that.
+  bool local_origin = false;
 };
 
 /// Coordinates beyond this magnitude are refused: squared distances would overflow a double.
@@ -75,7 +81,11 @@ class Mesh {
   int n_vertices() const { return static_cast<int>(positions_.size()); }
   int n_faces() const { return static_cast<int>(face_vertices_.size() / 3); }
 
+  /// Position of vertex v: file coordinates minus origin().
   const Vec3& position(int v) const { return positions_[v]; }
+  /// What was subtracted from the input's coordinates (zero unless IntakeOptions::local_origin):
+  /// file coordinates are position(v) + origin().
+  const Vec3& origin() const { return origin_; }
   /// Corner k (0..2) of face f, counter-clockwise seen from the normal.
   int face_vertex(int f, int k) const { return face_vertices_[3 * f + k]; }
   /// All corners, 3 per face (F #F by 3, row-major), for inner loops.
@@ -128,6 +138,7 @@ class Mesh {
   std::vector<int> input_to_mesh_;
   std::vector<std::size_t> mesh_to_input_;
   double average_edge_length_ = 0, bbox_diagonal_ = 0;
+  Vec3 origin_ = Vec3::Zero();
 };
 
 /// Straight-line (Euclidean) distance between two input vertices: the paper's
