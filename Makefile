@@ -3,7 +3,7 @@ PYTHON ?= python3
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test test-native test-python test-blender test-package demo clean wheel package bench bench-random
+.PHONY: deps build test test-native test-python test-blender test-package demo clean wheel package bench bench-random fuzz
 
 deps:
 	@scripts/install-deps.sh
@@ -43,6 +43,14 @@ bench: deps
 bench-random: deps
 	@BUILD_DIR=$(BUILD_DIR) PYTHON=$(PYTHON) JOBS=$(JOBS) BENCH_SECTIONS=random scripts/bench.sh
 
+# Fuzzing (issue 11): the libFuzzer targets under ASan+UBSan, FUZZ_SECONDS each (clang from Debian).
+# A finding fails; its input is left in $(FUZZ_DIR)/findings/ to be added to fuzz/regression/.
+FUZZ_SECONDS ?= 60
+FUZZ_DIR ?= build-fuzz
+fuzz: build
+	@PYTHON=$(PYTHON) scripts/install-fuzz-deps.sh
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_DIR=$(FUZZ_DIR) BUILD_DIR=$(BUILD_DIR) JOBS=$(JOBS) PYTHON=$(PYTHON) scripts/fuzz.sh
+
 # Packaging: the relief_snake_core wheel, and the two add-on zips (legacy + 4.2 extension) in dist/.
 wheel: deps
 	@PYTHON=$(PYTHON) scripts/build-wheel.sh
@@ -51,4 +59,4 @@ package: deps
 	@PYTHON=$(PYTHON) BUILD_DIR=$(BUILD_DIR) JOBS=$(JOBS) scripts/package.sh
 
 clean:
-	rm -rf $(BUILD_DIR) dist build-wheel build-package
+	rm -rf $(BUILD_DIR) dist build-wheel build-package build-fuzz

@@ -43,6 +43,8 @@ const char* kUsage =
     "\n"
     "MESH is an OBJ, PLY, STL or OFF file. Vertex indices (picks, I, J) are 0-based\n"
     "indices into the file's vertices, in file order.\n"
+    "  --allow-partial        (any command) load the readable part of a truncated or inconsistent\n"
+    "                         file, skipping invalid faces and vertices; what was skipped is reported\n"
     "\n"
     "segment: find the outline of the relief around (or beside) the picked vertices.\n"
     "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open)\n"
@@ -109,8 +111,13 @@ double parse_number(const std::string& text, const std::string& what) {
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value))
-    throw UsageError(what + " must be a finite number, got '" + text + "'");
+  if (text.empty() || end != text.c_str() + text.size())
+    throw UsageError(what + " must be a number, got '" + text + "'");
+  if (!std::isfinite(value) && errno != ERANGE) throw UsageError(what + " must be a finite number, got '" + text + "'");
+  if (errno == ERANGE && std::abs(value) > 1)
+    throw UsageError(what + " " + text + " is too large for double precision (beyond 1.8e308)");
+  if (errno == ERANGE)
+    throw UsageError(what + " " + text + " is too small for double precision (below 2.2e-308); give it in mesh units");
   return value;
 }
 
@@ -140,11 +147,19 @@ std::vector<std::int64_t> parse_picks(const std::string& text) {
   return picks;
 }
 
-/// Loads a mesh and checks that the given input vertices are usable as picks.
+/// --allow-partial (any command): intake keeps the readable part and reports what it skipped.
+bool g_allow_partial = false;
+
+/// Loads a mesh; a partial load is always reported on stderr, even with --quiet.
 rs::Mesh load_mesh(const std::string& path, double* load_seconds) {
   const auto start = std::chrono::steady_clock::now();
-  rs::Mesh mesh = rs::Mesh::load(path);
+  rs::IntakeOptions intake;
+  intake.allow_partial = g_allow_partial;
+  rs::Mesh mesh = rs::Mesh::load(path, intake);
   *load_seconds = seconds_since(start);
+  if (mesh.report().partial())
+    std::fprintf(stderr, "relief-snake: warning: partial load of %s: %s\n", path.c_str(),
+                 mesh.report().summary().c_str());
   return mesh;
 }
 
@@ -177,6 +192,8 @@ int run_info(const std::vector<std::string>& args) {
             << "unreferenced vertices: " << r.unreferenced_vertices << "\n"
             << "degenerate faces skipped: " << r.degenerate_faces << "\n"
             << "non-manifold faces refused: " << r.nonmanifold_faces << "\n"
+            << "invalid faces skipped (--allow-partial): " << r.invalid_faces << "\n"
+            << "invalid vertices ignored (--allow-partial): " << r.invalid_vertices << "\n"
             << "components: " << r.components << "\n"
             << "boundary edges: " << r.boundary_edges << "\n"
             << "average edge length: " << mesh.average_edge_length() << "\n"
@@ -366,7 +383,11 @@ int main(int argc, char** argv) {
       std::cout << help;
       return 0;
     }
-    const std::vector<std::string> rest(args.begin() + 1, args.end());
+    std::vector<std::string> rest;
+    for (auto it = args.begin() + 1; it != args.end(); ++it) {
+      if (*it == "--allow-partial") g_allow_partial = true;
+      else rest.push_back(*it);
+    }
     for (const std::string& arg : rest)
       if (arg == "--help") {
         std::cout << help;

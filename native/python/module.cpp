@@ -13,7 +13,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <algorithm>
 #include <exception>
+#include <stdexcept>
+#include <type_traits>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -44,8 +47,37 @@ struct CancelledError : std::exception {
 };
 
 // --- reading arrays ----------------------------------------------------------
+// Every Python object read here is held by a strong reference (py::object) for as long
+// as it is used: an item's __float__ / __index__ may run arbitrary code (even mutate the
+// container), so no borrowed item may outlive the call that produced it.
 
 enum class Kind { Float, Int };
+
+/// A wrong type in an input array: relief_snake_core.InputTypeError, which is both
+/// relief_snake_core.Error (a ValueError, as before) and a TypeError.
+struct InputTypeError : std::exception {
+  explicit InputTypeError(std::string message) : message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+  std::string message_;
+};
+
+/// repr() of a value for a message, at most 40 characters (repr may itself raise: then "?").
+std::string shown(py::handle value) {
+  std::string text = "?";
+  try {
+    text = std::string(py::str(py::repr(value)));
+  } catch (py::error_already_set&) {
+  }
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return std::string(py::str(py::type::of(value).attr("__name__"))) + " " + text;
+}
+
+/// "vertices[12][1]" or "picks[3]": where a value is.
+std::string position(const char* what, std::size_t i, long j = -1) {
+  std::string s = std::string(what) + "[" + std::to_string(i) + "]";
+  if (j >= 0) s += "[" + std::to_string(j) + "]";
+  return s;
+}
 
 /// Element type of a buffer format string, or false if it is not a plain number type.
 /// Byte-order prefixes other than native are refused: the engine reads native doubles.
@@ -66,7 +98,7 @@ bool is_float_code(char c) { return c == 'd' || c == 'f'; }
 bool is_int_code(char c) { return std::strchr("bBhHiIlLqQnN", c) != nullptr; }
 bool is_unsigned_code(char c) { return std::strchr("BHILQN", c) != nullptr; }
 
-/// Reads element k (in logical C order) of a buffer of any strides.
+/// Reads element k (in logical C order) of a 1D or 2D buffer of any strides (negative too).
 template <class T>
 T element_at(const py::buffer_info& info, py::ssize_t k) {
   const char* p = static_cast<const char*>(info.ptr);
@@ -112,22 +144,22 @@ std::string type_words(Kind kind) {
   return kind == Kind::Float ? "float32 or float64 ('f' or 'd')" : "integers (int32/int64/uint32: 'i', 'l', 'q', 'I', 'L')";
 }
 
-/// Copies a buffer of rows of 3 into a flat vector. `what` names the argument in messages.
+/// Copies a buffer of rows of 3 into a flat vector (one copy; a plain memcpy when the buffer is
+/// contiguous and already the engine's type). `what` names the argument in messages.
 template <class Out>
-std::vector<Out> read_buffer(const py::buffer& buffer, Kind kind, const char* what, bool rows_of_three) {
+std::vector<Out> read_buffer(py::handle obj, Kind kind, const char* what, bool rows_of_three) {
   py::buffer_info info;
   try {
-    info = buffer.request();  // strided request: non-contiguous views are read through their strides
+    info = py::reinterpret_borrow<py::buffer>(obj).request();  // strided request: views are read through their strides
   } catch (py::error_already_set&) {
-    throw Error(std::string(what) + ": cannot read this buffer; pass array.array, a numpy array or a list");
+    throw InputTypeError(std::string(what) + ": cannot read this buffer; pass array.array, a numpy array or a list");
   }
   char code = 0;
   bool native = true;
   if (!parse_format(info.format, &code, &native) || !(kind == Kind::Float ? is_float_code(code) : is_int_code(code)))
-    throw Error(std::string(what) + " must be " + type_words(kind) + ", got buffer format '" + info.format +
-                "'; convert it (e.g. array.array('" + (kind == Kind::Float ? "d" : "q") + "', ...))");
-  if (!native)
-    throw Error(std::string(what) + " is big-endian; convert it to native byte order first");
+    throw InputTypeError(std::string(what) + " must be " + type_words(kind) + ", got buffer format '" + info.format +
+                         "'; convert it (e.g. array.array('" + (kind == Kind::Float ? "d" : "q") + "', ...))");
+  if (!native) throw Error(std::string(what) + " is big-endian; convert it to native byte order first");
   if (!rows_of_three && info.ndim != 1)
     throw Error(std::string(what) + " must be 1D, got " + std::to_string(info.ndim) + " dimensions");
   if (info.ndim == 2) {
@@ -143,65 +175,111 @@ std::vector<Out> read_buffer(const py::buffer& buffer, Kind kind, const char* wh
     throw Error(std::string(what) + " has " + std::to_string(count) +
                 " values, not a multiple of 3; pass x, y, z (or 3 corners) per row");
   std::vector<Out> out(static_cast<std::size_t>(count));
+  const bool same_type = info.itemsize == static_cast<py::ssize_t>(sizeof(Out)) &&
+                         (std::is_floating_point<Out>::value ? code == 'd' : std::strchr("lqn", code) != nullptr);
+  bool contiguous = info.strides.back() == info.itemsize;
+  if (info.ndim == 2) contiguous = contiguous && info.strides[0] == info.shape[1] * info.itemsize;
+  if (same_type && contiguous) {
+    if (count > 0) std::memcpy(out.data(), info.ptr, static_cast<std::size_t>(count) * sizeof(Out));
+    return out;
+  }
   for (py::ssize_t k = 0; k < count; ++k)
     if (!read_element(info, code, k, &out[static_cast<std::size_t>(k)]))
-      throw Error(std::string(what) + ": value " + std::to_string(k) + " does not fit (item size " +
+      throw Error(std::string(what) + ": value " + std::to_string(k) + " does not fit in 64 bits (item size " +
                   std::to_string(info.itemsize) + ")");
   return out;
 }
 
+/// One number: an integer (anything with __index__, not bool, not float) or a float (anything
+/// with __float__ or __index__). `where` names its position.
 template <class Out>
-Out read_number(py::handle item, Kind kind, const char* what) {
+Out read_number(const py::object& item, Kind kind, const char* what, const std::string& where) {
+  PyObject* o = item.ptr();
   if (kind == Kind::Int) {
     // Refuse floats and strings: an index must be an integer, not something that rounds to one.
-    if (!PyIndex_Check(item.ptr()) || PyBool_Check(item.ptr()))
-      throw Error(std::string(what) + " must contain integers, got " + std::string(py::str(py::type::of(item).attr("__name__"))));
-    const long long v = PyLong_AsLongLong(py::reinterpret_steal<py::object>(PyNumber_Index(item.ptr())).ptr());
+    if (!PyIndex_Check(o) || PyBool_Check(o))
+      throw InputTypeError(std::string(what) + " must contain integers: " + where + " is " + shown(item));
+    const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(o));
+    if (!index) {
+      PyErr_Clear();
+      throw InputTypeError(std::string(what) + " must contain integers: " + where + " is " + shown(item) +
+                           " (its __index__ failed)");
+    }
+    const long long v = PyLong_AsLongLong(index.ptr());
     if (v == -1 && PyErr_Occurred()) {
       PyErr_Clear();
-      throw Error(std::string(what) + " contains an integer too large for 64 bits");
+      throw Error(std::string(what) + ": " + where + " = " + shown(index) + " is too large for 64 bits");
     }
     return static_cast<Out>(v);
   }
-  if (PyFloat_Check(item.ptr()) || (PyIndex_Check(item.ptr()) && !PyBool_Check(item.ptr())) ||
-      PyNumber_Check(item.ptr())) {
-    const double v = PyFloat_AsDouble(item.ptr());
-    if (v == -1.0 && PyErr_Occurred()) {
-      PyErr_Clear();
-      throw Error(std::string(what) + " must contain numbers");
-    }
-    return static_cast<Out>(v);
+  const bool numeric = !PyBool_Check(o) && (PyFloat_Check(o) || PyIndex_Check(o) ||
+                                            (Py_TYPE(o)->tp_as_number && Py_TYPE(o)->tp_as_number->nb_float));
+  if (!numeric) throw InputTypeError(std::string(what) + " must contain numbers: " + where + " is " + shown(item));
+  const double v = PyFloat_AsDouble(o);
+  if (v == -1.0 && PyErr_Occurred()) {
+    PyErr_Clear();
+    throw InputTypeError(std::string(what) + " must contain numbers: " + where + " is " + shown(item) +
+                         " (its conversion to float failed)");
   }
-  throw Error(std::string(what) + " must contain numbers, got " + std::string(py::str(py::type::of(item).attr("__name__"))));
+  return static_cast<Out>(v);
 }
 
 bool is_sequence(py::handle obj) {
-  return PySequence_Check(obj.ptr()) && !PyUnicode_Check(obj.ptr()) && !PyBytes_Check(obj.ptr());
+  return PySequence_Check(obj.ptr()) && !PyUnicode_Check(obj.ptr()) && !PyBytes_Check(obj.ptr()) &&
+         !PyByteArray_Check(obj.ptr());
+}
+
+/// len(seq) as a size, or a TypeError naming `where`.
+std::size_t sequence_length(py::handle seq, const std::string& where) {
+  const Py_ssize_t n = PySequence_Size(seq.ptr());
+  if (n < 0) {
+    PyErr_Clear();
+    throw InputTypeError(where + " has no length; pass a list, tuple or array");
+  }
+  return static_cast<std::size_t>(n);
+}
+
+/// seq[i] as a strong reference (a new reference from PySequence_GetItem).
+py::object sequence_item(py::handle seq, std::size_t i, const std::string& where) {
+  PyObject* item = PySequence_GetItem(seq.ptr(), static_cast<Py_ssize_t>(i));
+  if (!item) {
+    PyErr_Clear();
+    throw InputTypeError(where + " cannot be read (its __getitem__ failed)");
+  }
+  return py::reinterpret_steal<py::object>(item);
 }
 
 /// Any supported array-like to a flat vector: buffer, sequence of 3-sequences or flat sequence of numbers.
 template <class Out>
 std::vector<Out> read_array(py::handle obj, Kind kind, const char* what, bool rows_of_three) {
-  if (obj.is_none()) throw Error(std::string(what) + " is None; pass an array or a list of rows");
-  if (PyObject_CheckBuffer(obj.ptr())) return read_buffer<Out>(py::reinterpret_borrow<py::buffer>(obj), kind, what, rows_of_three);
+  if (obj.is_none()) throw InputTypeError(std::string(what) + " is None; pass an array or a list of rows");
+  if (PyObject_CheckBuffer(obj.ptr()) && !PyBytes_Check(obj.ptr()) && !PyByteArray_Check(obj.ptr()))
+    return read_buffer<Out>(obj, kind, what, rows_of_three);
   if (!is_sequence(obj))
-    throw Error(std::string(what) + " must be a buffer (array.array, numpy) or a sequence, got " +
-                std::string(py::str(py::type::of(obj).attr("__name__"))));
-  const auto seq = py::reinterpret_borrow<py::sequence>(obj);
+    throw InputTypeError(std::string(what) + " must be a buffer (array.array, numpy) or a sequence, got " + shown(obj));
+  const py::object seq = py::reinterpret_borrow<py::object>(obj);  // held for the whole read
+  const std::size_t n = sequence_length(seq, what);
   std::vector<Out> out;
-  out.reserve(seq.size() * (rows_of_three ? 3 : 1));
-  std::size_t row = 0;
-  for (py::handle item : seq) {
-    if (is_sequence(item)) {
-      const auto r = py::reinterpret_borrow<py::sequence>(item);
-      if (!rows_of_three || r.size() != 3)
-        throw Error(std::string(what) + ": row " + std::to_string(row) + " has " + std::to_string(r.size()) +
-                    (rows_of_three ? " values, expected 3" : " values, expected a single number"));
-      for (py::handle v : r) out.push_back(read_number<Out>(v, kind, what));
+  out.reserve(std::min<std::size_t>(n, std::size_t(1) << 24) * (rows_of_three ? 3 : 1));
+  for (std::size_t row = 0; row < n; ++row) {
+    const py::object item = sequence_item(seq, row, position(what, row));
+    if (is_sequence(item) || PyObject_CheckBuffer(item.ptr())) {
+      if (!rows_of_three)
+        throw InputTypeError(std::string(what) + " must contain single integers: " + position(what, row) + " is " +
+                             shown(item));
+      if (!is_sequence(item))
+        throw InputTypeError(position(what, row) + " is " + shown(item) + ", not a sequence of 3 numbers");
+      const std::size_t m = sequence_length(item, position(what, row));
+      if (m != 3)
+        throw Error(std::string(what) + ": row " + std::to_string(row) + " has " + std::to_string(m) +
+                    " values, expected 3");
+      for (std::size_t j = 0; j < 3; ++j) {
+        const std::string where = position(what, row, static_cast<long>(j));
+        out.push_back(read_number<Out>(sequence_item(item, j, where), kind, what, where));
+      }
     } else {
-      out.push_back(read_number<Out>(item, kind, what));
+      out.push_back(read_number<Out>(item, kind, what, position(what, row)));
     }
-    ++row;
   }
   if (rows_of_three && out.size() % 3 != 0)
     throw Error(std::string(what) + " has " + std::to_string(out.size()) +
@@ -209,30 +287,40 @@ std::vector<Out> read_array(py::handle obj, Kind kind, const char* what, bool ro
   return out;
 }
 
-std::vector<double> read_vertices(py::handle obj) {
+/// allow_partial: leave non-finite coordinates to intake, which skips the faces that use them.
+std::vector<double> read_vertices(py::handle obj, bool allow_partial = false) {
   std::vector<double> V = read_array<double>(obj, Kind::Float, "vertices", true);
   if (V.empty()) throw Error("vertices is empty; pass at least 3 vertices");
-  for (std::size_t k = 0; k < V.size(); ++k)
-    if (!std::isfinite(V[k]))
-      throw Error("vertex " + std::to_string(k / 3) + " has a non-finite coordinate (NaN or inf); fix the mesh");
+  if (!allow_partial)
+    for (std::size_t k = 0; k < V.size(); ++k)
+      if (!std::isfinite(V[k]))
+        throw Error("vertex " + std::to_string(k / 3) + " has a non-finite coordinate (NaN or inf) at " +
+                    position("vertices", k / 3, static_cast<long>(k % 3)) +
+                    "; fix the mesh, or pass allow_partial=True to skip the faces that use it");
   return V;
 }
 
-std::vector<std::int64_t> read_triangles(py::handle obj, std::size_t n_vertices) {
+std::vector<std::int64_t> read_triangles(py::handle obj, std::size_t n_vertices, bool allow_partial = false) {
   std::vector<std::int64_t> F = read_array<std::int64_t>(obj, Kind::Int, "triangles", true);
   if (F.empty()) throw Error("triangles is empty; pass at least one triangle");
-  for (std::size_t k = 0; k < F.size(); ++k)
-    if (F[k] < 0 || static_cast<std::uint64_t>(F[k]) >= n_vertices)
-      throw Error("triangle " + std::to_string(k / 3) + " uses vertex " + std::to_string(F[k]) +
-                  ", out of range 0.." + std::to_string(static_cast<long long>(n_vertices) - 1));
+  if (!allow_partial)
+    for (std::size_t k = 0; k < F.size(); ++k)
+      if (F[k] < 0 || static_cast<std::uint64_t>(F[k]) >= n_vertices)
+        throw Error("triangle " + std::to_string(k / 3) + " uses vertex " + std::to_string(F[k]) +
+                    ", out of range 0.." + std::to_string(static_cast<long long>(n_vertices) - 1) +
+                    "; fix the triangles, or pass allow_partial=True to skip such triangles");
   return F;
 }
 
-std::unique_ptr<Mesh> build_mesh(py::handle vertices, py::handle triangles) {
-  const std::vector<double> V = read_vertices(vertices);
-  const std::vector<std::int64_t> F = read_triangles(triangles, V.size() / 3);
+/// Arrays to a Mesh: each array is copied once into the engine's layout (GIL held), then intake
+/// reads those copies in place with the GIL released.
+std::unique_ptr<Mesh> build_mesh(py::handle vertices, py::handle triangles, bool allow_partial = false) {
+  const std::vector<double> V = read_vertices(vertices, allow_partial);
+  const std::vector<std::int64_t> F = read_triangles(triangles, V.size() / 3, allow_partial);
+  IntakeOptions intake;
+  intake.allow_partial = allow_partial;
   py::gil_scoped_release release;
-  return std::make_unique<Mesh>(Mesh::from_triangles(V.data(), V.size() / 3, F.data(), F.size() / 3));
+  return std::make_unique<Mesh>(Mesh::from_triangles(V.data(), V.size() / 3, F.data(), F.size() / 3, intake));
 }
 
 // --- segmentation ---------------------------------------------------------------
@@ -371,10 +459,27 @@ py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, const 
   return out;
 }
 
+/// The Segmenters whose progress callback is running on this thread (innermost last): a
+/// segment() on one of them from inside its own callback would wait forever for its own lock.
+thread_local std::vector<const Segmenter*> t_running_callbacks;
+
+/// Marks `segmenter`'s callback as running on this thread for a scope.
+class CallbackScope {
+ public:
+  explicit CallbackScope(const Segmenter* segmenter) { t_running_callbacks.push_back(segmenter); }
+  ~CallbackScope() { t_running_callbacks.pop_back(); }
+  CallbackScope(const CallbackScope&) = delete;
+  CallbackScope& operator=(const CallbackScope&) = delete;
+};
+
 /// Runs one segmentation with the GIL released. The Python callback (if any) is
 /// called with the GIL re-acquired; its exception cancels the run and is re-raised here.
 py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lock, py::handle picks_obj,
                           const Options& options, py::object progress, double seconds_before) {
+  if (std::find(t_running_callbacks.begin(), t_running_callbacks.end(), &segmenter) != t_running_callbacks.end())
+    throw std::runtime_error(
+        "Mesh.segment was called from its own progress callback, which would wait for itself forever; "
+        "segment again after the running call returns, or use another Mesh");
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::int64_t> picks = read_picks(picks_obj);
   const auto n_input = static_cast<std::int64_t>(mesh.input_vertex_count());
@@ -390,8 +495,10 @@ py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lo
     // The contour goes to Python (a list of tuples: ~1 ms for a few thousand snaxels) at
     // most every kContourSeconds and at every phase's first call; other calls get None.
     auto last_contour = std::make_shared<std::pair<std::string, std::chrono::steady_clock::time_point>>();
-    callback = [&progress, &callback_error, last_contour](const Progress& p) -> bool {
+    const Segmenter* running = &segmenter;
+    callback = [&progress, &callback_error, last_contour, running](const Progress& p) -> bool {
       py::gil_scoped_acquire acquire;
+      const CallbackScope scope(running);
       if (callback_error) return false;
       try {
         const auto now = std::chrono::steady_clock::now();
@@ -435,7 +542,8 @@ py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lo
 /// The Python Mesh: a validated mesh and its Segmenter (planarity cache), kept together.
 class PyMesh {
  public:
-  PyMesh(py::handle vertices, py::handle triangles) : mesh_(build_mesh(vertices, triangles)) {
+  PyMesh(py::handle vertices, py::handle triangles, bool allow_partial)
+      : mesh_(build_mesh(vertices, triangles, allow_partial)) {
     py::gil_scoped_release release;
     segmenter_ = std::make_unique<Segmenter>(*mesh_);
   }
@@ -481,6 +589,22 @@ PYBIND11_MODULE(relief_snake_core, m) {
   py::register_exception<CancelledError>(m, "Cancelled", PyExc_Exception);
   m.attr("Error").attr("__doc__") = "Bad input or a segmentation that cannot succeed; the message says what to do.";
   m.attr("Cancelled").attr("__doc__") = "The progress callback returned False.";
+  {
+    // Both relief_snake_core.Error (as wrong input always was) and TypeError (what it is).
+    // Kept for the process's lifetime (never released: it outlives the interpreter's module teardown).
+    static PyObject* input_type_error = PyErr_NewExceptionWithDoc(
+        "relief_snake_core.InputTypeError", "An input array holds a value of the wrong type; the message names it.",
+        py::make_tuple(m.attr("Error"), py::handle(PyExc_TypeError)).ptr(), nullptr);
+    if (!input_type_error) throw py::error_already_set();
+    m.attr("InputTypeError") = py::handle(input_type_error);
+    py::register_exception_translator([](std::exception_ptr p) {
+      try {
+        if (p) std::rethrow_exception(p);
+      } catch (const InputTypeError& e) {
+        PyErr_SetString(input_type_error, e.what());
+      }
+    });
+  }
 
   const char* segment_doc =
       "segment(vertices, triangles, picks, step_height=None, *, w_int='auto', open_contour=False,\n"
@@ -495,6 +619,8 @@ PYBIND11_MODULE(relief_snake_core, m) {
       "between); returning False raises Cancelled. Returns the result document of docs/result-format.md\n"
       "(status: converged, doubtful or iteration_cap, with message and reasons; contour; relief_vertices;\n"
       "step_height; checks; phases; parameters; notes; mesh; timing), the same as the CLI writes.\n"
+      "allow_partial=True skips (and reports in the result's mesh) triangles with out-of-range corners or\n"
+      "non-finite vertices instead of raising.\n"
       "**advanced: the engine's advanced options by name (e.g. tau=0.2, exact_q=True); advanced_options()\n"
       "lists them with their types, ranges and defaults. An unknown name raises TypeError.";
 
@@ -502,11 +628,11 @@ PYBIND11_MODULE(relief_snake_core, m) {
       "segment",
       [](py::object vertices, py::object triangles, py::object picks, py::object step_height, py::object w_int,
          bool open_contour, const std::string& relief_side, int max_iterations, py::object progress,
-         const py::kwargs& advanced) {
+         bool allow_partial, const py::kwargs& advanced) {
         // Options are checked before the (possibly long) mesh construction.
         const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
         const auto start = std::chrono::steady_clock::now();
-        std::unique_ptr<Mesh> mesh = build_mesh(vertices, triangles);
+        std::unique_ptr<Mesh> mesh = build_mesh(vertices, triangles, allow_partial);
         std::unique_ptr<Segmenter> segmenter;
         {
           py::gil_scoped_release release;
@@ -518,7 +644,8 @@ PYBIND11_MODULE(relief_snake_core, m) {
       },
       py::arg("vertices"), py::arg("triangles"), py::arg("picks"), py::arg("step_height") = py::none(), py::kw_only(),
       py::arg("w_int") = "auto", py::arg("open_contour") = false, py::arg("relief_side") = "auto",
-      py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), segment_doc);
+      py::arg("max_iterations") = 3000, py::arg("progress") = py::none(), py::arg("allow_partial") = false,
+      segment_doc);
 
   m.def(
       "advanced_options",
@@ -548,15 +675,21 @@ PYBIND11_MODULE(relief_snake_core, m) {
 
   m.def(
       "mesh_report",
-      [](py::object vertices, py::object triangles) { return build_mesh(vertices, triangles)->report().summary(); },
-      py::arg("vertices"), py::arg("triangles"),
+      [](py::object vertices, py::object triangles, bool allow_partial) {
+        return build_mesh(vertices, triangles, allow_partial)->report().summary();
+      },
+      py::arg("vertices"), py::arg("triangles"), py::kw_only(), py::arg("allow_partial") = false,
       "mesh_report(vertices, triangles) -> str: one-line summary of what mesh intake kept, merged or refused.");
 
   py::class_<PyMesh>(m, "Mesh",
                      "A validated mesh that keeps its planarity cache between segmentations "
                      "(segmenting a second relief with the same h costs only the snake).")
-      .def(py::init([](py::object vertices, py::object triangles) { return std::make_unique<PyMesh>(vertices, triangles); }),
-           py::arg("vertices"), py::arg("triangles"))
+      .def(py::init([](py::object vertices, py::object triangles, bool allow_partial) {
+             return std::make_unique<PyMesh>(vertices, triangles, allow_partial);
+           }),
+           py::arg("vertices"), py::arg("triangles"), py::kw_only(), py::arg("allow_partial") = false,
+           "Mesh(vertices, triangles, *, allow_partial=False): allow_partial skips (and reports) triangles with "
+           "out-of-range corners or non-finite vertices instead of raising")
       .def_property_readonly("report", [](const PyMesh& self) { return self.mesh().report().summary(); })
       .def_property_readonly("n_vertices", [](const PyMesh& self) { return self.mesh().n_vertices(); })
       .def_property_readonly("n_faces", [](const PyMesh& self) { return self.mesh().n_faces(); })

@@ -280,6 +280,94 @@ bool shortest_edge_path(const Mesh& mesh, int va, int vb, SurfacePath* out) {
   return true;
 }
 
+namespace {
+
+// --- picks that cannot enclose anything ---------------------------------------------
+// A closed contour's picks, seen along their average normal, must go round once: a pick
+// polygon that crosses itself (figure-eight order) or encloses almost no area (collinear
+// picks) converges to nothing useful, so it is refused with the order that would work.
+
+/// Pick k's 2D position in the plane across the picks' average normal.
+std::vector<Eigen::Vector2d> project_picks(const Mesh& mesh, const std::vector<int>& picks) {
+  Vec3 normal = Vec3::Zero(), centre = Vec3::Zero();
+  for (int v : picks) {
+    normal += mesh.vertex_normal(v);
+    centre += mesh.position(v);
+  }
+  centre /= static_cast<double>(picks.size());
+  if (normal.norm() < 1e-9) normal = Vec3::UnitZ();  // normals cancel: any projection (the tests below then decide)
+  normal.normalize();
+  const Vec3 u = normal.unitOrthogonal(), w = normal.cross(u);
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(picks.size());
+  for (int v : picks) {
+    const Vec3 d = mesh.position(v) - centre;
+    out.emplace_back(d.dot(u), d.dot(w));
+  }
+  return out;
+}
+
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+/// Whether segments pq and rs cross at a point inside both (touching ends do not count).
+bool segments_cross(const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r,
+                    const Eigen::Vector2d& s, double tolerance) {
+  const double d1 = cross2(q - p, r - p), d2 = cross2(q - p, s - p);
+  const double d3 = cross2(s - r, p - r), d4 = cross2(s - r, q - r);
+  return ((d1 > tolerance && d2 < -tolerance) || (d1 < -tolerance && d2 > tolerance)) &&
+         ((d3 > tolerance && d4 < -tolerance) || (d3 < -tolerance && d4 > tolerance));
+}
+
+/// "1, 2, 4, 3": the picks' 1-based positions sorted by angle around their centre.
+std::string order_by_angle(const std::vector<Eigen::Vector2d>& points) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& p : points) centre += p;
+  centre /= static_cast<double>(points.size());
+  std::vector<std::size_t> order(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto angle = [&](std::size_t i) { return std::atan2(points[i].y() - centre.y(), points[i].x() - centre.x()); };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return angle(a) < angle(b); });
+  // Start at the first pick, keep the user's direction if the sorted ring allows it.
+  std::rotate(order.begin(), std::find(order.begin(), order.end(), std::size_t(0)), order.end());
+  if (order.size() > 2 && order[1] > order.back()) std::reverse(order.begin() + 1, order.end());
+  std::string text;
+  for (std::size_t i = 0; i < order.size(); ++i) text += (i ? ", " : "") + std::to_string(order[i] + 1);
+  return text;
+}
+
+}  // namespace
+
+void check_pick_polygon(const Mesh& mesh, const std::vector<int>& picks) {
+  const std::size_t n = picks.size();
+  if (n < 3) return;
+  const std::vector<Eigen::Vector2d> p = project_picks(mesh, picks);
+  double perimeter = 0, twice_area = 0, extent = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& a = p[i];
+    const auto& b = p[(i + 1) % n];
+    perimeter += (b - a).norm();
+    twice_area += cross2(a, b);
+    extent = std::max(extent, a.norm());
+  }
+  const double tolerance = 1e-12 * extent * extent;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
+      if (segments_cross(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n], tolerance))
+        throw Error("the picks' order crosses itself (the line from pick " + std::to_string(i + 1) + " to " +
+                    std::to_string((i + 1) % n + 1) + " crosses the one from pick " + std::to_string(j + 1) + " to " +
+                    std::to_string((j + 1) % n + 1) + "), so the contour cannot go round the relief; pick in order "
+                    "around it, e.g. as " + order_by_angle(p));
+    }
+  // Isoperimetric ratio 4 pi A / P^2: 1 for a circle, 0.6 for a square, 0.03 for a 1:100 rectangle, ~0
+  // for points on a line (0.02: a triangle whose height is 1.3% of its base).
+  const double roundness = perimeter > 0 ? 4 * M_PI * 0.5 * std::abs(twice_area) / (perimeter * perimeter) : 0;
+  if (roundness < 0.02)
+    throw Error("the picks enclose almost no area (they lie nearly on one line, seen across the surface), so the "
+                "contour cannot go round the relief; pick points all around the relief");
+}
+
+
 InitialContour initial_contour(const Mesh& mesh, const std::vector<int>& picks, bool closed) {
   const std::size_t n = picks.size();
   if (closed && n < 3) throw Error("a closed contour needs at least 3 picked points around the relief");
@@ -293,6 +381,7 @@ InitialContour initial_contour(const Mesh& mesh, const std::vector<int>& picks, 
     if ((i + 1 < n || closed) && picks[i] == picks[(i + 1) % n])
       throw Error("the same point is picked twice in a row; remove the repeated pick");
   }
+  if (closed) check_pick_polygon(mesh, picks);
 
   InitialContour result;
   const std::size_t legs = closed ? n : n - 1;

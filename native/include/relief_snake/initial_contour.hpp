@@ -35,10 +35,17 @@ struct InitialContour {
   std::vector<std::size_t> pick_index; ///< pick k is path[pick_index[k]]
 };
 
+/// Refuses (Error, with the order by angle around the picks' centre as advice) closed-contour
+/// picks that cannot go round a relief: seen along their average vertex normal, the pick
+/// polygon crosses itself (figure-eight order) or encloses almost no area (4 pi A / P^2 < 0.02:
+/// collinear picks). picks: mesh vertex indices, >= 3.
+void check_pick_polygon(const Mesh& mesh, const std::vector<int>& picks);
+
 /// Joins the picks (mesh vertex indices) in order, and last to first when closed,
 /// by plane sections with the shortest-path fallback per leg. Throws Error for
-/// fewer than 3 (closed) or 2 (open) picks, bad indices, repeated consecutive picks
-/// or picks on different connected parts of the mesh.
+/// fewer than 3 (closed) or 2 (open) picks, bad indices, repeated consecutive picks,
+/// picks on different connected parts of the mesh, or (closed) a pick polygon that
+/// check_pick_polygon refuses.
 InitialContour initial_contour(const Mesh& mesh, const std::vector<int>& picks, bool closed);
 
 /// Arc length of a path (closed: including the segment from the last point to the first).

@@ -1,6 +1,8 @@
 #pragma once
 // Mesh intake: arrays or files in, a validated triangle mesh out, with a report of
 // everything that was merged, split or refused (nothing is dropped silently).
+// Files are parsed by mesh_io.hpp; OpenMesh is used inside intake only (to find the
+// faces that would make the surface non-manifold) and is gone once the Mesh exists.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -8,20 +10,35 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+
+#include "relief_snake/mesh_io.hpp"
 
 namespace relief_snake {
 
 using Vec3 = Eigen::Vector3d;
 
-struct MeshTraits : public OpenMesh::DefaultTraits {
-  typedef OpenMesh::Vec3d Point;
-  typedef OpenMesh::Vec3d Normal;
+/// How strict intake is.
+struct IntakeOptions {
+  /// Skip (and count) faces with out-of-range corners or non-finite / too-large corner coordinates,
+  /// and keep the readable part of a truncated or inconsistent file (MeshReport::notes says what
+  /// was skipped). Off: any of these is an error that names the face, vertex or line.
+  bool allow_partial = false;
+  /// Store positions relative to the bounding-box centre of the valid vertices (origin()), for
+  /// coordinates far beyond the mesh's size. At +1e6 doubles in file coordinates segment like the
+  /// scan at the origin (test_mesh_offset); this is for larger offsets, where the engine's
+  /// plane-fit moment sums (sums of squares) lose the detail. Off by default: the Segmenter does
+  /// not add origin() back to its 3D results yet, so a caller that sets it must do that.
+  bool local_origin = false;
 };
-using TriMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
+
+/// Coordinates beyond this magnitude are refused: squared distances would overflow a double.
+constexpr double kMaxCoordinate = 1e150;
+/// Vertex and triangle counts must stay below 2^31: the adjacency arrays index with int.
+constexpr std::size_t kMaxMeshElements = (std::size_t(1) << 31) - 1;
 
 /// What intake did with the input. Every input face is accounted for:
-/// input_faces = faces_kept_as_triangles + polygons_triangulated + degenerate_faces + nonmanifold_faces.
+/// input_faces = faces_kept_as_triangles + polygons_triangulated + degenerate_faces + nonmanifold_faces
+///               + invalid_faces.
 struct MeshReport {
   std::size_t input_vertices = 0;
   std::size_t input_faces = 0;
@@ -31,6 +48,13 @@ struct MeshReport {
   std::size_t unreferenced_vertices = 0;       ///< input vertices used by no kept face
   std::size_t degenerate_faces = 0;            ///< repeated corners or zero area: skipped
   std::size_t nonmanifold_faces = 0;           ///< would make an edge or vertex non-manifold: refused
+  /// allow_partial only: faces with an out-of-range corner or a corner whose coordinates are
+  /// non-finite or beyond kMaxCoordinate, skipped.
+  std::size_t invalid_faces = 0;
+  std::size_t invalid_vertices = 0;            ///< allow_partial only: non-finite or too-large vertices ignored
+  /// allow_partial only: what the file reader skipped (truncation, count mismatches), one sentence each.
+  std::vector<std::string> notes;
+  bool partial() const { return invalid_faces > 0 || invalid_vertices > 0 || !notes.empty(); }
   std::size_t components = 0;                  ///< connected components (by faces)
   std::size_t boundary_edges = 0;
   /// One line, e.g. "120000 triangles, 2 components; 3 degenerate faces skipped, 1 non-manifold face refused".
@@ -42,19 +66,26 @@ struct MeshReport {
 /// array) vertex indices map to mesh vertices through input_to_mesh().
 class Mesh {
  public:
-  /// V: nv by 3 row-major coordinates; F: nf by 3 zero-based corner indices.
-  /// Throws Error on empty input, out-of-range indices or non-finite coordinates.
-  static Mesh from_triangles(const double* V, std::size_t nv, const std::int64_t* F, std::size_t nf);
+  /// V: nv by 3 row-major coordinates; F: nf by 3 zero-based corner indices. Read in place (no copy).
+  /// Throws Error on empty input, out-of-range indices or non-finite coordinates (unless allow_partial).
+  static Mesh from_triangles(const double* V, std::size_t nv, const std::int64_t* F, std::size_t nf,
+                             const IntakeOptions& options = {});
   /// Polygons of any size: face k has corners[offsets[k] .. offsets[k+1]); offsets has nf+1 entries.
-  static Mesh from_polygons(std::vector<Vec3> V, const std::vector<std::int64_t>& corners,
-                            const std::vector<std::size_t>& offsets);
-  /// OBJ, PLY, STL or OFF, read by OpenMesh. Throws Error if unreadable.
-  static Mesh load(const std::string& path);
+  static Mesh from_polygons(const std::vector<Vec3>& V, const std::vector<std::int64_t>& corners,
+                            const std::vector<std::size_t>& offsets, const IntakeOptions& options = {});
+  /// A file's (or a caller's) polygon soup; messages name the soup's lines where it has them.
+  static Mesh from_soup(const PolygonSoup& soup, const IntakeOptions& options = {});
+  /// OBJ, PLY, STL or OFF (read_mesh_file). Throws Error, naming the path and the line or element.
+  static Mesh load(const std::string& path, const IntakeOptions& options = {});
 
   int n_vertices() const { return static_cast<int>(positions_.size()); }
   int n_faces() const { return static_cast<int>(face_vertices_.size() / 3); }
 
+  /// Position of vertex v: file coordinates minus origin().
   const Vec3& position(int v) const { return positions_[v]; }
+  /// What was subtracted from the input's coordinates (zero unless IntakeOptions::local_origin):
+  /// file coordinates are position(v) + origin().
+  const Vec3& origin() const { return origin_; }
   /// Corner k (0..2) of face f, counter-clockwise seen from the normal.
   int face_vertex(int f, int k) const { return face_vertices_[3 * f + k]; }
   /// All corners, 3 per face (F #F by 3, row-major), for inner loops.
@@ -89,13 +120,13 @@ class Mesh {
   std::size_t mesh_to_input(int v) const { return mesh_to_input_[v]; }
 
   const MeshReport& report() const { return report_; }
-  /// The OpenMesh structure the arrays were read from (halfedges, boundary walks).
-  const TriMesh& openmesh() const { return om_; }
 
  private:
+  struct Input;  // the validated view intake works on (mesh_intake.cpp)
+  static Mesh build(const Input& input, const IntakeOptions& options);
+  /// Everything but positions_, face_vertices_ and face_neighbors_ (mesh_adjacency.cpp).
   void build_arrays();
 
-  TriMesh om_;
   MeshReport report_;
   std::vector<Vec3> positions_, face_normals_, vertex_normals_;
   std::vector<double> face_areas_, vertex_areas_;
@@ -107,6 +138,7 @@ class Mesh {
   std::vector<int> input_to_mesh_;
   std::vector<std::size_t> mesh_to_input_;
   double average_edge_length_ = 0, bbox_diagonal_ = 0;
+  Vec3 origin_ = Vec3::Zero();
 };
 
 /// Straight-line (Euclidean) distance between two input vertices: the paper's
