@@ -47,6 +47,8 @@ double cotangent(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 /// The ring's best-fit plane and a quadric w = P(s, t) fitted to the ring over it.
+using Vec2d = Eigen::Vector2d;
+
 struct HeightFieldFrame {
   Vec3 origin = Vec3::Zero(), e1 = Vec3::UnitX(), e2 = Vec3::UnitY(), n = Vec3::UnitZ();
   double scale = 1;  // coordinates divided by it in the quadric (conditioning)
@@ -68,11 +70,26 @@ struct HeightFieldFrame {
     const Vec3 d = x - origin;
     return d.dot(n) - quadric(d.dot(e1), d.dot(e2));
   }
-  /// The point above x's foot in the plane at `offset` over the quadric.
-  Vec3 point(const Vec3& x, double offset_value) const {
-    const Vec3 d = x - origin;
-    const double s = d.dot(e1), t = d.dot(e2);
-    return origin + s * e1 + t * e2 + (quadric(s, t) + offset_value) * n;
+  /// The point over plane coordinates (s, t) at `offset` above the quadric.
+  Vec3 point(const Vec2d& st, double offset_value) const {
+    return origin + st.x() * e1 + st.y() * e2 + (quadric(st.x(), st.y()) + offset_value) * n;
+  }
+  /// Plane coordinates of the quadric's point nearest x (the foot of x along the quadric's
+  /// normal), so a relief vertex keeps its place over the base even where the plane tilts
+  /// away from the surface. A few fixed-point steps: the quadric is gentle at this scale.
+  Vec2d foot(const Vec3& x) const {
+    const Vec3 d0 = x - origin;
+    Vec2d st(d0.dot(e1), d0.dot(e2));
+    for (int it = 0; it < 4; ++it) {
+      const double s = st.x() / scale, t = st.y() / scale;
+      const double ps = (coefficients[1] + 2 * coefficients[3] * s + coefficients[4] * t) / scale;
+      const double pt = (coefficients[2] + coefficients[4] * s + 2 * coefficients[5] * t) / scale;
+      const Vec3 normal = (n - ps * e1 - pt * e2).normalized();
+      const Vec3 d = x - point(st, 0);
+      const Vec3 tangential = d - d.dot(normal) * normal;
+      st += Vec2d(tangential.dot(e1), tangential.dot(e2));
+    }
+    return st;
   }
 };
 
@@ -280,6 +297,23 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
                    "the background folds over its best-fit plane, so it is no height field; use the surface model");
   r.model = height_field ? BackgroundModel::HeightField : BackgroundModel::Surface;
 
+  // Plane coordinates of each vertex involved: the foot along the quadric's normal for region
+  // vertices (lifted by the relief), the plain projection for the background's.
+  std::vector<Vec2d> footprint;
+  if (height_field) {
+    footprint.resize(static_cast<std::size_t>(nv));
+    auto set_footprint = [&](int v) {
+      if (r.region[v]) {
+        footprint[v] = frame.foot(mesh.position(v));
+      } else {
+        const Vec3 q = frame.plane_point(mesh.position(v));
+        footprint[v] = Vec2d(q.x(), q.y());
+      }
+    };
+    for (const int v : unknowns) set_footprint(v);
+    for (const int v : fixed) set_footprint(v);
+  }
+
   // Laplacian weights per one-ring entry and areas: the scan's (Surface) or those of the plane
   // projection (HeightField: a planar parameterisation, so linear offsets fill exactly).
   const std::vector<double>* weights = &edge_weight_;
@@ -299,7 +333,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
         face_done[*f] = 1;
         const int c[3] = {mesh.face_vertex(*f, 0), mesh.face_vertex(*f, 1), mesh.face_vertex(*f, 2)};
         Vec3 q[3];
-        for (int k = 0; k < 3; ++k) q[k] = frame.plane_point(mesh.position(c[k]));
+        for (int k = 0; k < 3; ++k) q[k] = Vec3(footprint[c[k]].x(), footprint[c[k]].y(), 0);
         const double signed_third = (q[1] - q[0]).cross(q[2] - q[0]).z() / 6.0;
         for (int k = 0; k < 3; ++k) area[c[k]] += std::abs(signed_third);
         // Folded faces (steep relief walls) get no cotangent weight: they are not part of the base.
@@ -318,7 +352,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   const int dims = height_field ? 1 : 3;
   // Known values: the offset from the quadric (HeightField) or the position (Surface).
   auto value = [&](int v) -> Eigen::Vector3d {
-    if (height_field) return Eigen::Vector3d(frame.offset(mesh.position(v)), 0, 0);
+    if (height_field) return Eigen::Vector3d(frame.offset(mesh.position(v)), 0, 0);  // background: over its projection
     return mesh.position(v);
   };
 
@@ -382,7 +416,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   for (int v = 0; v < nv; ++v) r.base_positions[v] = mesh.position(v);
   for (Eigen::Index u = 0; u < nu; ++u) {
     const int v = unknowns[u];
-    r.base_positions[v] = height_field ? frame.point(mesh.position(v), X(u, 0)) : Vec3(X.row(u).transpose());
+    r.base_positions[v] = height_field ? frame.point(footprint[v], X(u, 0)) : Vec3(X.row(u).transpose());
   }
   r.base_normals.resize(static_cast<std::size_t>(nv));
   for (int v = 0; v < nv; ++v) r.base_normals[v] = mesh.vertex_normal(v);
