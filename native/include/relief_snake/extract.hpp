@@ -61,7 +61,7 @@ struct ExtractionFiles {
   std::string background_ply, relief_ply, height_exr, height_png, height_json;
   double png_scale = 0, png_offset = 0;
 };
-/// Writes DIR/background.ply, DIR/relief.ply, DIR/height.exr, DIR/height.png and DIR/height.json
+/// (native/src/io: link relief_snake_io.) Writes DIR/background.ply, DIR/relief.ply, DIR/height.exr, DIR/height.png and DIR/height.json
 /// (creating DIR if needed). All five are written under temporary names and renamed only when
 /// every one succeeded. Throws Error.
 ExtractionFiles write_extraction(const Mesh& mesh, const ExtractResult& result, const std::string& directory);
