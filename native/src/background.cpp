@@ -189,8 +189,9 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
                                                        " vertices; give a region of this mesh");
   if (!(h > 0) || !std::isfinite(h))
     return failure(BackgroundStatus::BadParameter, "the step height h must be a positive number");
-  if (!(options_.ring_width > 0) || !(options_.smoothing >= 0))
-    return failure(BackgroundStatus::BadParameter, "ring_width must be > 0 and smoothing >= 0 (in units of h)");
+  if (!(options_.ring_width > 0) || !(options_.smoothing >= 0) || !(options_.smoothing_band >= 0))
+    return failure(BackgroundStatus::BadParameter,
+                   "ring_width must be > 0, smoothing and smoothing_band >= 0 (in units of h)");
 
   BackgroundResult r;
   r.region.assign(region_in.begin(), region_in.end());
@@ -225,11 +226,15 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   std::vector<int> hops(static_cast<std::size_t>(nv), std::numeric_limits<int>::max());
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  for (const int v : r.region_vertices) {
-    dist[v] = 0;
-    hops[v] = 0;
-    queue.push({0.0, v});
-  }
+  // Seeds: the background vertices next to the region (distances through the relief's step
+  // would count its height).
+  for (const int v : r.region_vertices)
+    for (const int* it = mesh.neighbors_begin(v); it != mesh.neighbors_end(v); ++it)
+      if (!r.region[*it] && hops[*it] != 1) {
+        dist[*it] = 0;
+        hops[*it] = 1;
+        queue.push({0.0, *it});
+      }
   while (!queue.empty()) {
     const auto [d, v] = queue.top();
     queue.pop();
@@ -259,7 +264,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   std::vector<int> unknown_id(static_cast<std::size_t>(nv), -1), fixed_id(static_cast<std::size_t>(nv), -1);
   std::vector<int> unknowns;
   for (int v = 0; v < nv; ++v)
-    if (r.region[v] || (soft && in_ring[v])) {
+    if (r.region[v] || (soft && in_ring[v] && dist[v] <= options_.smoothing_band * h)) {
       unknown_id[v] = static_cast<int>(unknowns.size());
       unknowns.push_back(v);
     }
@@ -397,6 +402,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     const double stiffness = 1.0 / (s * s * s * s);
     for (const int v : r.ring_vertices) {
       const int u = unknown_id[v];
+      if (u < 0) continue;  // beyond the fitted band: fixed
       const double weight = stiffness * (area[v] > 0 ? area[v] : mesh.vertex_area(v));
       Q.coeffRef(u, u) += weight;
       rhs.row(u) += weight * value(v).head(dims).transpose();
@@ -441,12 +447,16 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   r.height.assign(static_cast<std::size_t>(nv), 0.0);
   for (int v = 0; v < nv; ++v)
     if (r.region[v] || in_ring[v]) r.height[v] = (mesh.position(v) - r.base_positions[v]).dot(r.base_normals[v]);
+  // The residual over the fitted (soft) part of the ring; the rest is fixed, at height 0.
   double sum2 = 0;
+  std::size_t fitted = 0;
   for (const int v : r.ring_vertices) {
+    if (unknown_id[v] < 0) continue;
+    ++fitted;
     sum2 += r.height[v] * r.height[v];
     r.ring_max_residual = std::max(r.ring_max_residual, std::abs(r.height[v]));
   }
-  r.ring_rms_residual = std::sqrt(sum2 / static_cast<double>(r.ring_vertices.size()));
+  r.ring_rms_residual = fitted ? std::sqrt(sum2 / static_cast<double>(fitted)) : 0.0;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

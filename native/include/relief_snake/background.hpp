@@ -39,6 +39,9 @@ struct BackgroundOptions {
   BackgroundModel model = BackgroundModel::Auto;
   double ring_width = 3;   ///< width of the background ring fitted around the region, in units of h
   double smoothing = 0.5;  ///< smoothing length s, in units of h; 0: the ring is fixed exactly
+  /// The ring's inner band this wide (in h) is fitted softly, the rest of the ring stays fixed
+  /// (the quadric is fitted to the whole ring). A narrower band is a smaller solve.
+  double smoothing_band = 1;
   BackgroundLaplacian laplacian = BackgroundLaplacian::Cotangent;
 };
 
@@ -67,8 +70,8 @@ struct BackgroundResult {
   /// #V: signed height of each vertex above the base along the base normal,
   /// (position - base) . normal; region and ring vertices, 0 elsewhere.
   std::vector<double> height;
-  /// The ring's heights above the fitted surface: root mean square, and the largest magnitude
-  /// (0 when smoothing = 0: the ring is fixed).
+  /// The fitted band's heights above the fitted surface: root mean square, and the largest
+  /// magnitude (0 when smoothing = 0: the ring is fixed).
   double ring_rms_residual = 0, ring_max_residual = 0;
   double seconds = 0;  ///< time of solve()
 
