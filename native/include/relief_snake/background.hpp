@@ -3,15 +3,17 @@
 // continued from the background around the relief region (Liu et al. 2007, "Background
 // surface estimation for reverse engineering of reliefs", by a thin-plate fill).
 //
-// A ring of background a few h wide around the region is fitted, softly, by a smooth
-// surface that continues into the region: the minimiser of
-//     sum_v A_v |L x|_v^2  +  sum_{ring} A_v / s^4 |x_v - x0_v|^2
-// over the region's and the ring's vertex positions x (L: cotangent or uniform Laplacian
-// with vertex areas A; s: the smoothing length; vertices beyond the ring stay fixed, so
-// position and tangent continue across the ring's outer edge). With s = 0 the ring is
-// fixed exactly (a biharmonic fill). One sparse SPD solve (Eigen SimplicialLDLT) gives all
-// three coordinates. How far the ring lies from the fitted surface is the fit residual:
-// how well a smooth surface explains the background around the relief.
+// A ring of background ring_width h wide around the region is fitted by a smooth surface that
+// continues into the region, the minimiser of
+//     sum_v A_v |L x|_v^2  +  sum_{band} A_v / s^4 |x_v - x0_v|^2
+// over the region's values x and those of the ring's inner band (L: cotangent or uniform
+// Laplacian with vertex areas A; s: the smoothing length); the rest of the ring stays fixed, so
+// value and tangent continue across the contour. x is either the offset from a quadric fitted
+// to the ring over its best-fit plane (HeightField, exact for quadrics) or the vertex position
+// itself (Surface, for backgrounds that fold over any plane). With s = 0 the ring is fixed exactly
+// (a biharmonic fill). One sparse SPD solve (Eigen SimplicialLDLT). How far the band lies from
+// the fitted surface is the fit residual: how well a smooth surface explains the background
+// around the relief.
 //
 // Used by extraction (extract.hpp) and meant for the snake's robustness checks: fit the
 // background outside a contour, then ask for heights above it (height_above()).
