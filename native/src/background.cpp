@@ -271,7 +271,9 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   std::vector<char> is_row(static_cast<std::size_t>(nv), 0);
   std::vector<int> rows;
   auto add_row = [&](int v) {
-    if (!is_row[v] && !mesh.is_boundary_vertex(v)) {  // boundary rows: natural boundary conditions
+    // Boundary vertices get rows too (their one-sided Laplacian): without them the values along a
+    // mesh border the region reaches would be underdetermined.
+    if (!is_row[v]) {
       is_row[v] = 1;
       rows.push_back(v);
     }

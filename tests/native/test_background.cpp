@@ -171,3 +171,32 @@ TEST(Background, SingleVertexBumpOnAPlaneIsRemoved) {
 
 }  // namespace
 }  // namespace relief_snake
+
+namespace relief_snake {
+namespace {
+
+TEST(Background, ReliefRunningOffTheMeshBorder) {
+  // The open shape: a relief cut by the mesh's right edge, so the region reaches the border
+  // (a regression: values along the border were underdetermined without its rows).
+  synthetic::ScanSpec spec;
+  spec.shape = synthetic::Shape::Open;
+  spec.background = synthetic::Background::Cylinder;
+  spec.triangles = 30000;
+  spec.seed = 4;
+  const synthetic::Scan scan = synthetic::generate(spec);
+  const Mesh mesh = synthetic::to_mesh(scan);
+  const BackgroundResult fill = BackgroundSolver(mesh).solve(std::vector<char>(scan.relief.begin(), scan.relief.end()), scan.h);
+  ASSERT_TRUE(fill.ok()) << fill.message;
+  bool on_border = false;
+  for (const int v : fill.region_vertices) on_border = on_border || mesh.is_boundary_vertex(v);
+  ASSERT_TRUE(on_border);
+  const test::FillErrors e = test::fill_errors(scan, fill, 1.0 * scan.h);
+  std::printf("[ measured ] open relief on a cylinder: base mean %.4f max %.4f, height mean %.4f max %.4f\n", e.mean_base,
+              e.max_base, e.mean_height, e.max_height);
+  EXPECT_LE(e.mean_base, 0.05 * scan.h);
+  EXPECT_LE(e.mean_height, 0.05 * scan.h);
+  EXPECT_LE(e.max_height, 0.2 * scan.h);
+}
+
+}  // namespace
+}  // namespace relief_snake
