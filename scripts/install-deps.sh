@@ -4,7 +4,8 @@
 set -euo pipefail
 
 APT_PACKAGES=(build-essential cmake pkg-config libopenmesh-dev libeigen3-dev
-              libgtest-dev pybind11-dev nlohmann-json3-dev)
+              libgtest-dev pybind11-dev nlohmann-json3-dev
+              libopenexr-dev libpng-dev)
 
 missing=()
 for pkg in "${APT_PACKAGES[@]}"; do
@@ -14,7 +15,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "install-deps: apt-get install ${missing[*]}" >&2
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -o DPkg::Lock::Timeout=600 -y -qq --no-install-recommends "${missing[@]}"
 fi
 
 PYTHON=${PYTHON:-python3}

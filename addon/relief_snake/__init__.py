@@ -23,9 +23,9 @@ if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submod
 
 import bpy
 
-from . import ordering, properties, mesh_io, preview, api, operators, panel
+from . import ordering, properties, mesh_io, preview, api, operators, panel, extract_operators, extract_panel
 
-_classes = properties.classes + operators.classes + panel.classes
+_classes = properties.classes + operators.classes + panel.classes + extract_operators.classes + extract_panel.classes
 
 
 def register():

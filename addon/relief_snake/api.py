@@ -157,3 +157,6 @@ def apply_result(obj, result, *, group_name="Relief", make_curve=True):
     timing = result.setdefault("timing", {})
     timing["write"] = time.perf_counter() - t0
     return result
+
+
+from .extraction import extract_object, apply_relief, add_displace  # noqa: E402,F401 (extraction imports this module)

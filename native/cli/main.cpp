@@ -23,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "extract_command.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/option_table.hpp"
 #include "relief_snake/result_json.hpp"
@@ -39,6 +40,7 @@ const char* kUsage =
     "  relief-snake segment MESH --picks I,J,K,... [--step-height H|auto] [options]\n"
     "  relief-snake measure MESH I J\n"
     "  relief-snake info MESH\n"
+    "  relief-snake extract MESH RESULT.json --out DIR [options]\n"
     "  relief-snake --help\n"
     "\n"
     "MESH is an OBJ, PLY, STL or OFF file. Vertex indices (picks, I, J) are 0-based\n"
@@ -377,7 +379,7 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
-    const std::string help = std::string(kUsage) + "\n" + advanced_options_help();
+    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + advanced_options_help();
     const std::string command = args[0];
     if (command == "--help" || command == "-h" || command == "help") {
       std::cout << help;
@@ -393,10 +395,11 @@ int main(int argc, char** argv) {
         std::cout << help;
         return 0;
       }
-    if (command == "segment") return run_segment(rest);
+    if (command == "segment") return rs::cli::run_segment_with_extract(rest, run_segment);
+    if (command == "extract") return rs::cli::run_extract(rest);
     if (command == "measure") return run_measure(rest);
     if (command == "info") return run_info(rest);
-    throw UsageError("unknown command '" + command + "'; use segment, measure or info (see relief-snake --help)");
+    throw UsageError("unknown command '" + command + "'; use segment, measure, info or extract (see relief-snake --help)");
   } catch (const UsageError& e) {
     return fail(e.what(), 2);
   } catch (const rs::Error& e) {

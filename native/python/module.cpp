@@ -577,8 +577,13 @@ double measure_vertices(py::handle vertices, std::int64_t i, std::int64_t j) {
 }  // namespace
 }  // namespace relief_snake
 
+namespace relief_snake {
+void register_extract_bindings(py::module_& m);  // extract_bindings.cpp
+}
+
 PYBIND11_MODULE(relief_snake_core, m) {
   using namespace relief_snake;
+  register_extract_bindings(m);
   m.doc() =
       "Relief Snake engine: segment a relief on a triangle mesh from a few picked vertices and its step height "
       "(Segmenting Reliefs on Triangle Meshes, sections 5-7). Arrays go in through the buffer protocol; numpy "

@@ -117,7 +117,7 @@ def main():
 
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()
-    for name in ("test_ordering", "test_addon"):
+    for name in ("test_ordering", "test_addon", "test_extraction"):
         suite.addTests(loader.loadTestsFromName(name))
     t0 = time.perf_counter()
     result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)
