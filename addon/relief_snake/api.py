@@ -73,11 +73,12 @@ def measure(obj, i, j):
 
 
 def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
-            max_iterations=3000, options=None, read_seconds=0.0):
+            max_iterations=3000, options=None, read_seconds=0.0, flushed=False):
     """Validate and read everything the engine needs (main thread, bpy access); writes nothing.
 
     step_height None asks the engine to estimate h; w_int None lets it choose the smoothness.
-    Returns a job.Request; raises EngineError."""
+    flushed: Edit Mode changes were just flushed (selected_picks did it), so the whole-mesh copy
+    update_from_editmode makes is not made twice. Returns a job.Request; raises EngineError."""
     from . import mesh_io
     _mesh_object(obj)
     t0 = time.perf_counter()
@@ -85,7 +86,8 @@ def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_s
         h, kwargs = validation.engine_arguments(len(picks), step_height, w_int, open_contour, relief_side)
     except ValueError as exc:
         raise EngineError(str(exc)) from None
-    mesh_io.sync_edit_mode(obj)
+    if not flushed:
+        mesh_io.sync_edit_mode(obj)
     vertices, triangles = mesh_io.read_buffers(obj.data)
     if not triangles:
         raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
@@ -161,4 +163,5 @@ def apply_result(obj, result, *, group_name="Relief", make_curve=True):
         mesh_io.write_curve(obj, contour, result.get("closed", True))
     timing = result.setdefault("timing", {})
     timing["write"] = time.perf_counter() - t0
+    timing["total"] = timing.get("read", 0.0) + timing.get("engine", 0.0) + timing["write"]
     return result

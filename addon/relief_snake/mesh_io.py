@@ -158,7 +158,7 @@ def _contour_material():
 def write_curve(obj, contour, closed, radius=None):
     """A 3D POLY curve through `contour` (list of (x, y, z) in obj's object space), parented to
     obj (identity parent inverse, so it sits on the mesh wherever obj is), drawn as an orange
-    tube of `radius` (default: a third of the mean point spacing) in front of the mesh.
+    tube of `radius` (default: 0.6 of the mean point spacing) in front of the mesh.
 
     An existing "<obj>_ReliefContour" curve object is kept and its curve data refilled.
     Returns the curve object.
@@ -186,7 +186,7 @@ def write_curve(obj, contour, closed, radius=None):
     if radius is None:
         n = len(contour)
         length = sum(sum((contour[i][k] - contour[i - 1][k]) ** 2 for k in range(3)) ** 0.5 for i in range(1, n))
-        radius = length / max(1, n - 1) / 3.0
+        radius = 0.6 * length / max(1, n - 1)
     curve.bevel_depth = radius
     curve.bevel_resolution = 2
     curve.use_fill_caps = True

@@ -65,7 +65,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             obj, picks, None if self.estimate_step_height else self.step_height,
             w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
             relief_side=self.relief_side.lower(), options=_threads_option(context),
-            read_seconds=time.perf_counter() - t0)  # selection + click order count as data transfer too
+            read_seconds=time.perf_counter() - t0, flushed=True)  # selection + click order count as data transfer too
         return obj, request, info
 
     def _finish(self, context, obj, result, info):

@@ -32,7 +32,7 @@ MODULE_DIR = os.environ.get("RELIEF_SNAKE_MODULE_DIR", BUILD)
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
     edit = "--edit" in argv
-    argv = [a for a in argv if not a.startswith("--")]
+    argv = [a for a in argv if a and not a.startswith("--")]
     triangles = int(argv[0]) if argv else 300000
     sys.path[:0] = [MODULE_DIR, os.path.join(ROOT, "addon"), HERE]
     import addon_utils
@@ -92,3 +92,6 @@ def _run_operator(api, obj, truth, label):
              segmentation, "reused" if r["mesh_cached"] else "built", other, r.get("status")))
 
 
+
+if __name__ == "__main__":
+    main()
