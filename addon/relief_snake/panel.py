@@ -10,7 +10,7 @@ def _wrap(layout, context, text, icon='NONE'):
     """Labels for `text`, wrapped to the region's width (Blender's labels cut, they never wrap)."""
     region = context.region
     scale = context.preferences.view.ui_scale
-    chars = max(16, int((region.width if region else 300) / (7.0 * scale)) - 3)
+    chars = max(16, int((region.width if region else 300) / (7.0 * scale)) - 6)  # room for the icon
     first = True
     for paragraph in text.splitlines():
         for line in textwrap.wrap(paragraph, chars) or [""]:
