@@ -476,6 +476,7 @@ def scenario_artist():
     started = yield from press_segment(button, wait=False)
     check("Segment starts an interactive run", started)
     seen, reply = False, {}
+    yield from wait_until(job_running, 15, 0.05)  # the read happens on the run's first timer tick
     for _ in range(20):
         if not job_running():
             break
