@@ -3,7 +3,7 @@ PYTHON ?= python3
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build test test-native test-python test-blender test-package demo clean wheel package bench bench-random fuzz
+.PHONY: deps build test test-native test-python test-blender test-package test-blender-ui demo clean wheel package bench bench-random fuzz
 
 deps:
 	@scripts/install-deps.sh
@@ -18,7 +18,7 @@ test-native: build
 test-python: build
 	RELIEF_SNAKE_BUILD_DIR=$(BUILD_DIR) $(PYTHON) -m pytest -q tests/python --ignore=tests/python/test_package.py
 
-# The add-on suite in Debian's Blender 3.4 and in bpy 4.2 (scripts/install-blender.sh installs both).
+# The add-on suite in Debian's Blender 3.4, bpy 4.5 LTS and bpy 5.2 LTS (scripts/install-blender.sh installs them).
 test-blender: build
 	@BUILD_DIR=$(BUILD_DIR) scripts/test-blender.sh
 
@@ -29,7 +29,13 @@ test-package: build
 	@PYTHON=$(PYTHON) BUILD_DIR=$(BUILD_DIR) JOBS=$(JOBS) DIST=$(BUILD_DIR)/dist STAGE=$(BUILD_DIR)/package-stage scripts/package.sh
 	RELIEF_SNAKE_DIST=$(BUILD_DIR)/dist RELIEF_SNAKE_REQUIRE_PACKAGES=1 $(PYTHON) -m pytest -q tests/python/test_package.py
 
-test: test-native test-python test-blender test-package
+# Real-window tests: Blender 3.4 on Xvfb driven by xdotool, installing the legacy zip that
+# test-package built; screenshots and logs in $(BUILD_DIR)/blender-ui-artifacts.
+test-blender-ui: test-package
+	$(PYTHON) tests/blender/ui/harness.py --zip $(BUILD_DIR)/dist/relief_snake-$$(sed -n 's/^version = "\(.*\)"$$/\1/p' pyproject.toml | head -1)-legacy.zip \
+	  --build-dir $(BUILD_DIR) --out $(BUILD_DIR)/blender-ui-artifacts
+
+test: test-native test-python test-blender test-package test-blender-ui
 
 demo: build
 	@scripts/demo.sh
@@ -51,7 +57,7 @@ fuzz: build
 	@PYTHON=$(PYTHON) scripts/install-fuzz-deps.sh
 	@FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_DIR=$(FUZZ_DIR) BUILD_DIR=$(BUILD_DIR) JOBS=$(JOBS) PYTHON=$(PYTHON) scripts/fuzz.sh
 
-# Packaging: the relief_snake_core wheel, and the two add-on zips (legacy + 4.2 extension) in dist/.
+# Packaging: the relief_snake_core wheels (cp311, cp313), the legacy zip and one extension zip per Blender Python in dist/.
 wheel: deps
 	@PYTHON=$(PYTHON) scripts/build-wheel.sh
 

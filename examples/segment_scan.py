@@ -36,7 +36,7 @@ def parse_args():
     p.add_argument("--picks", help="vertex indices around the relief, in order (comma separated)")
     p.add_argument("--step-height", type=float, help="h, the relief's step height")
     p.add_argument("--truth", help="make-scan truth JSON: picks, h, open, relief_side (and IoU report)")
-    p.add_argument("--w-int", type=float, default=0.25)
+    p.add_argument("--w-int", type=float, default=None, help="smoothness in (0, 1]; default: the engine chooses")
     p.add_argument("--open", action="store_true", help="open contour ending on the mesh boundary")
     p.add_argument("--side", choices=("left", "right"), default="left", help="relief side (open contours)")
     p.add_argument("--out", required=True, help="output directory for the .blend and the .png")
@@ -63,9 +63,13 @@ def parse_args():
 def enable_addon(build_dir):
     """The installed add-on if there is one, else this tree's (the module from build_dir)."""
     import addon_utils
+    # Only names Blender knows: enabling a missing add-on prints a traceback even when it is caught.
+    known = {m.__name__ for m in addon_utils.modules()}
     for name in ("relief_snake", "bl_ext.user_default.relief_snake"):
+        if name not in known:
+            continue
         try:
-            mod = addon_utils.enable(name, default_set=True)
+            mod = addon_utils.enable(name, default_set=True, handle_error=lambda exc: None)
         except Exception:
             mod = None
         if mod is not None:
@@ -76,7 +80,8 @@ def enable_addon(build_dir):
                 addon_utils.disable(name)
     sys.path.insert(0, build_dir)  # example script, not the add-on: path tweaks are fine here
     sys.path.insert(0, os.path.join(ROOT, "addon"))
-    mod = addon_utils.enable("relief_snake", default_set=True)
+    mod = addon_utils.enable("relief_snake", default_set=True, handle_error=lambda exc: print(
+        "segment_scan: enabling the add-on from this tree failed: %s" % exc))
     if mod is None:
         raise SystemExit("segment_scan: could not enable the relief_snake add-on")
     mod.api.load_core()  # fails with a clear message if the native module is missing
@@ -108,7 +113,8 @@ def import_scan(path):
 
 
 def frame_camera(obj, scene):
-    """An orthographic camera looking at the mesh along its average normal."""
+    """An orthographic camera looking at the mesh obliquely (50 degrees off its average normal),
+    so the relief's step shades against the background; a sun from the side."""
     mesh = obj.data
     mw = obj.matrix_world
     from mathutils import Vector
@@ -116,6 +122,9 @@ def frame_camera(obj, scene):
     for poly in mesh.polygons:
         n += poly.normal * poly.area
     n = (mw.to_3x3() @ n).normalized() if n.length > 0 else Vector((0, 0, 1))
+    from mathutils import Matrix
+    side = n.orthogonal().normalized()
+    view = (Matrix.Rotation(0.87, 3, side) @ n).normalized()  # tilt the view ~50 degrees
     corners = [mw @ Vector(c) for c in obj.bound_box]
     centre = sum(corners, Vector((0, 0, 0))) / 8
     size = max((c - centre).length for c in corners) * 2
@@ -125,14 +134,48 @@ def frame_camera(obj, scene):
     cam_data.clip_end = size * 10
     cam = bpy.data.objects.new("Camera", cam_data)
     scene.collection.objects.link(cam)
-    cam.location = centre + n * size * 2
-    cam.rotation_euler = (-n).to_track_quat('-Z', 'Y').to_euler()
+    cam.location = centre + view * size * 2
+    cam.rotation_euler = (-view).to_track_quat('-Z', 'Y').to_euler()
     scene.camera = cam
     light_data = bpy.data.lights.new("Sun", 'SUN')
     light = bpy.data.objects.new("Sun", light_data)
     scene.collection.objects.link(light)
-    light.rotation_euler = cam.rotation_euler
+    light.rotation_euler = (-(view + side).normalized()).to_track_quat('-Z', 'Y').to_euler()
     return cam
+
+
+def mark_picks(obj, picks, radius):
+    """A small blue ball on every pick (the vertices the outline started from)."""
+    import bmesh
+    mesh = bpy.data.meshes.new("Picks")
+    bm = bmesh.new()
+    for i in picks:
+        co = obj.data.vertices[i].co
+        m = bmesh.ops.create_icosphere(bm, subdivisions=2, radius=radius)
+        bmesh.ops.translate(bm, verts=m["verts"], vec=co)
+    bm.to_mesh(mesh)
+    bm.free()
+    ob = bpy.data.objects.new("Picks", mesh)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.parent = obj
+    ob.show_in_front = True
+    mesh.materials.append(_material("Picks", (0.1, 0.35, 1.0, 1.0)))
+    return ob
+
+
+def title(scene, text):
+    """The picture's title, stamped on the render."""
+    r = scene.render
+    for attr in dir(r):
+        if attr.startswith("use_stamp_") and attr != "use_stamp_note":
+            try:
+                setattr(r, attr, False)
+            except (AttributeError, TypeError):
+                pass
+    r.use_stamp = True
+    r.use_stamp_note = True
+    r.stamp_note_text = text
+    r.stamp_font_size = 28
 
 
 def _material(name, rgba):
@@ -236,10 +279,12 @@ def main():
 
     result = addon.api.segment_object(obj, args.picks, args.step_height, w_int=args.w_int,
                                       open_contour=args.open, relief_side=args.side)
-    ordering = addon.ordering  # bpy-free summaries
-    print(ordering.result_summary(result))
-    for line in ordering.phase_summary(result):
+    summary = addon.summary  # bpy-free summaries
+    print("Relief Snake: " + summary.result_summary(result))
+    for line in summary.phase_lines(result):
         print("  " + line)
+    if summary.status_warning(result):
+        print("Relief Snake: warning: " + summary.status_warning(result))
     timing = result["timing"]
     print("segment_scan: read %.2f s, engine %.2f s, write %.2f s"
           % (timing["read"], timing["engine"], timing["write"]))
@@ -249,7 +294,10 @@ def main():
 
     curve = bpy.data.objects.get(obj.name + "_ReliefContour")
     style(obj, curve, result["relief_vertices"])
+    mark_picks(obj, args.picks, max(obj.dimensions) * 0.006)
     frame_camera(obj, scene)
+    title(scene, "Relief Snake: %s - %d picks (blue), outline (orange), relief (tan), %d vertices"
+          % (os.path.basename(args.mesh), len(args.picks), len(result["relief_vertices"])))
     name = os.path.splitext(os.path.basename(args.mesh))[0]
     blend = os.path.abspath(os.path.join(args.out, name + ".blend"))
     png = os.path.abspath(os.path.join(args.out, name + ".png"))

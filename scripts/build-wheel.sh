@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
-# Builds the relief_snake_core wheel into dist/ (or $WHEEL_DIR):
-#   dist/relief_snake_core-<version>-cp311-cp311-linux_x86_64.whl
+# Builds the relief_snake_core wheel for $PYTHON into dist/ (or $WHEEL_DIR):
+#   dist/relief_snake_core-<version>-cp311-cp311-manylinux_2_<N>_x86_64.whl   (PYTHON=python3.11)
+#   dist/relief_snake_core-<version>-cp313-cp313-manylinux_2_<N>_x86_64.whl   (PYTHON=python3.13)
+# The platform tag tells the truth: `auditwheel show` (from PyPI, in .venv-wheeltools) reads the
+# glibc / libstdc++ symbol versions the module and its bundled library need and names the
+# manylinux policy they fit; the wheel is tagged with it (the build fails if none fits).
 # Two ways, one content (the module and Debian's libOpenMeshCore in relief_snake_core.libs/,
 # found through RUNPATH $ORIGIN/relief_snake_core.libs, not through the system):
 #
@@ -30,7 +34,8 @@ fi
 
 scripts/install-deps.sh
 mkdir -p "$WHEEL_DIR"
-rm -f "$WHEEL_DIR"/relief_snake_core-*.whl
+py_tag=$("$PYTHON" -c 'import sys; print("cp%d%d" % sys.version_info[:2])')
+rm -f "$WHEEL_DIR"/relief_snake_core-*-"$py_tag"-*.whl
 
 if [ -z "$from_build" ]; then
   if ! "$PYTHON" -c "import scikit_build_core, pybind11" >/dev/null 2>&1; then
@@ -134,7 +139,55 @@ with zipfile.ZipFile(wheel, "w", zipfile.ZIP_DEFLATED) as z:
 PY
 fi
 
-wheel=$(ls "$WHEEL_DIR"/relief_snake_core-*.whl)
+wheel=$(ls "$WHEEL_DIR"/relief_snake_core-*-"$py_tag"-*.whl)
+
+# --- the truthful platform tag (auditwheel show) ---------------------------------------------
+TOOLS=${WHEEL_TOOLS_VENV:-.venv-wheeltools}
+if [ ! -x "$TOOLS/bin/auditwheel" ]; then
+  echo "build-wheel: pip install auditwheel into $TOOLS" >&2
+  "$PYTHON" -m venv "$TOOLS"
+  for i in 1 2 3; do "$TOOLS/bin/python" -m pip install -q auditwheel && break; sleep 10; done
+fi
+policy=$("$TOOLS/bin/auditwheel" show "$wheel" 2>/dev/null \
+  | tr '\n' ' ' | sed -n 's/.*following platform tag: *"\([a-z0-9_]*\)".*/\1/p')
+case "$policy" in
+  manylinux_*) ;;
+  *) echo "build-wheel: auditwheel finds no manylinux policy for $wheel (got '$policy'):" >&2
+     "$TOOLS/bin/auditwheel" show "$wheel" >&2 || true
+     exit 1 ;;
+esac
+"$PYTHON" - "$wheel" "$policy" <<'PY'
+import base64, hashlib, os, sys, zipfile
+src, policy = sys.argv[1:3]
+name = os.path.basename(src)
+base, plat = name[:-4].rsplit("-", 1)
+if plat == policy:
+    sys.exit(0)
+dst = os.path.join(os.path.dirname(src), "%s-%s.whl" % (base, policy))
+with zipfile.ZipFile(src) as z:
+    items = [(i, z.read(i.filename)) for i in z.infolist()]
+out, record_name = [], None
+for info, data in items:
+    if info.filename.endswith(".dist-info/WHEEL"):
+        data = data.decode().replace("-" + plat + "\n", "-" + policy + "\n").encode()
+    if info.filename.endswith(".dist-info/RECORD"):
+        record_name = info.filename
+        continue
+    out.append((info.filename, data))
+lines = []
+for n, data in out:
+    digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+    lines.append("%s,sha256=%s,%d" % (n, digest, len(data)))
+lines.append(record_name + ",,")
+out.append((record_name, ("\n".join(lines) + "\n").encode()))
+tmp = dst + ".tmp"
+with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+    for n, data in out:
+        z.writestr(n, data)
+os.replace(tmp, dst)
+os.remove(src)
+PY
+wheel=$(ls "$WHEEL_DIR"/relief_snake_core-*-"$py_tag"-*.whl)
 # The wheel must carry libOpenMeshCore and find it through $ORIGIN, not through the system.
 "$PYTHON" - "$wheel" <<'PY'
 import sys, zipfile

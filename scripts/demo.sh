@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # `make demo`: the bundled sample scan (a synthetic duck relief from make-scan), segmented
 # headless in Debian's Blender by examples/segment_scan.py; prints where the .blend and PNG went.
+# The picture: an oblique view of the scan with the picks (blue), the outline (orange) and the
+# relief (tan), titled.
 # `make demo` builds first; run directly, this script builds too if the build is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,5 +36,5 @@ if [ "$status" -ne 0 ] || [ ! -s "$OUT/duck.blend" ] || [ ! -s "$OUT/duck.png" ]
   tail -20 "$OUT/blender.log" >&2
   exit 1
 fi
-echo "demo: .blend   $PWD/$OUT/duck.blend"
-echo "demo: picture  $PWD/$OUT/duck.png"
+echo "demo: .blend   $(cd "$OUT" && pwd)/duck.blend"
+echo "demo: picture  $(cd "$OUT" && pwd)/duck.png"

@@ -1,8 +1,11 @@
 """Relief Snake: segment reliefs (carvings, embossings) on scanned triangle meshes.
 
 Select vertices around a relief in click order, set the step height, press Segment:
-the relief vertices land in a vertex group and the contour in a curve object.
+the relief vertices land in a vertex group and the outline in a curve object.
 Scripting: see the `api` submodule.
+
+Modules: pick_order, validation, summary and job know nothing of bpy (tested in plain
+Python); mesh_io, api, units, properties, preview, operators and panel are the Blender side.
 """
 
 bl_info = {
@@ -15,15 +18,20 @@ bl_info = {
     "category": "Mesh",
 }
 
+_MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "mesh_io", "preview", "api",
+            "operators", "panel")
+
 if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submodules
     import importlib
-    for _name in ("ordering", "properties", "mesh_io", "preview", "api", "operators", "panel"):
+    if "preview" in locals():
+        preview.stop()  # noqa: F821  (the previous module's handler, before it is reloaded)
+    for _name in _MODULES:
         if _name in locals():
             importlib.reload(locals()[_name])
 
 import bpy
 
-from . import ordering, properties, mesh_io, preview, api, operators, panel, extract_operators, extract_panel
+from . import pick_order, validation, summary, job, units, properties, mesh_io, preview, api, operators, panel, extract_operators, extract_panel
 
 _classes = properties.classes + operators.classes + panel.classes + extract_operators.classes + extract_panel.classes
 
@@ -32,10 +40,18 @@ def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
     bpy.types.Scene.relief_snake = bpy.props.PointerProperty(type=properties.ReliefSnakeSettings)
+    properties.register_handlers()
 
 
 def unregister():
+    # A running worker is asked to stop; its result is dropped (it holds no Blender data).
+    job.cancel_all(wait=2.0)
+    job.MESH_CACHE.clear()
+    running = operators.MESH_OT_relief_snake_segment._modal
+    if running is not None:
+        running._cleanup(bpy.context)
     preview.stop()
+    properties.unregister_handlers()
     del bpy.types.Scene.relief_snake
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

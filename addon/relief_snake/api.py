@@ -1,31 +1,33 @@
-"""Scripting API of the Relief Snake add-on.
+"""Scripting API of the Relief Snake add-on, and the one pipeline the Segment operator uses too.
 
     import relief_snake.api as rs            # or: from <package> import api as rs
     result = rs.segment_object(obj, picks=[12, 40, 77, 103], step_height=1.0)
     h = rs.measure(obj, 12, 13)
 
-segment_object() reads the object's mesh data (no modifiers; Edit Mode changes are
-flushed first), runs the native engine (relief_snake_core) and, when write=True,
-stores the relief vertices in a vertex group and the contour in a curve object.
-Nothing is written unless the engine succeeded. Distances and step heights are
-in the object's local space (the engine sees object coordinates).
+The pipeline: prepare() reads the object's mesh data (no modifiers; Edit Mode changes are
+flushed first) into a job.Request on the main thread; job.run_engine() runs the native engine
+(relief_snake_core) with no bpy access, so the operator runs it in a worker thread; and
+apply_result() writes the relief vertices into a vertex group and the outline into a curve
+object. Nothing is written unless the engine succeeded. Distances and step heights are in the
+object's local space (the engine sees object coordinates). The engine's Mesh for an object is
+cached (job.MESH_CACHE, keyed by the object's name and a fingerprint of its mesh data), so a
+second segmentation of an unchanged scan skips mesh intake and reuses the planarity.
 """
 
 import time
 
-from . import ordering
+from . import pick_order, validation
+from .job import MESH_CACHE, EngineError, Request, fingerprint, run_engine
 
-__all__ = ["load_core", "EngineError", "segment_object", "apply_result", "measure", "selected_picks"]
+__all__ = ["load_core", "EngineError", "segment_object", "prepare", "run_engine", "apply_result", "measure",
+           "selected_picks", "MESH_CACHE"]
 
 _core = None
 
 
-class EngineError(RuntimeError):
-    """Any failure worth a one-line user report (bad input, engine error, missing module)."""
-
-
 def load_core():
-    """The native module: bundled next to the add-on, else from sys.path."""
+    """The native module: bundled next to the add-on (legacy zip), else from sys.path (the
+    extension's wheel, or a build directory)."""
     global _core
     if _core is None:
         try:
@@ -49,13 +51,13 @@ def _mesh_object(obj):
 
 
 def selected_picks(obj):
-    """Picks from the selection: (picks, info) where info is None or a sentence
-    saying the angle fallback was used (click order missing or partial)."""
+    """Picks from the selection: (picks, info) where info is None or a sentence saying the
+    angle fallback was used (click order missing or partial)."""
     from . import mesh_io
     _mesh_object(obj)
     mesh_io.sync_edit_mode(obj)
     selected, history, positions, normals = mesh_io.read_selection(obj)
-    return ordering.order_picks(selected, history, positions, normals)
+    return pick_order.order_picks(selected, history, positions, normals)
 
 
 def measure(obj, i, j):
@@ -67,46 +69,25 @@ def measure(obj, i, j):
     for k in (i, j):
         if not 0 <= k < n:
             raise EngineError("Vertex %d does not exist (the mesh has %d vertices)" % (k, n))
-    return ordering.distance(mesh_io.vertex_position(obj.data, i), mesh_io.vertex_position(obj.data, j))
+    return pick_order.distance(mesh_io.vertex_position(obj.data, i), mesh_io.vertex_position(obj.data, j))
 
 
-def segment_object(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_side="left",
-                   max_iterations=3000, progress=None, write=True, group_name="Relief",
-                   make_curve=True, options=None):
-    """Segment the relief marked by `picks` (vertex indices, in order) on mesh object `obj`.
+def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
+            max_iterations=3000, options=None, read_seconds=0.0, flushed=False):
+    """Validate and read everything the engine needs (main thread, bpy access); writes nothing.
 
-    `options` (dict, optional): the engine's advanced options by name, e.g.
-    {"exact_q": True}; relief_snake_core.advanced_options() lists them.
-
-    Returns the engine's result dict (status, closed, contour [(x, y, z)] in object
-    space, relief_vertices, phases, ...) plus "timing": {"read", "engine", "write"}
-    seconds. Raises EngineError with the engine's one-line message on failure, and
-    relief_snake_core.Cancelled if `progress` returned False. With write=True the
-    vertex group `group_name` and (make_curve) the curve "<obj>_ReliefContour" are
-    replaced; on any failure nothing is written.
-    """
-    core = load_core()
-    job = prepare(obj, picks, step_height, w_int=w_int, open_contour=open_contour,
-                  relief_side=relief_side, max_iterations=max_iterations, options=options)
-    result = run(core, job, progress)
-    if write:
-        apply_result(obj, result, group_name=group_name, make_curve=make_curve)
-    return result
-
-
-def prepare(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_side="left",
-            max_iterations=3000, options=None):
-    """Validate and read everything the engine needs (main thread, bpy access).
-
-    Returns a job dict for run(); raises EngineError."""
+    step_height None asks the engine to estimate h; w_int None lets it choose the smoothness.
+    flushed: Edit Mode changes were just flushed (selected_picks did it), so the whole-mesh copy
+    update_from_editmode makes is not made twice. Returns a job.Request; raises EngineError."""
     from . import mesh_io
     _mesh_object(obj)
     t0 = time.perf_counter()
     try:
-        kwargs = ordering.validate_options(len(picks), step_height, w_int, open_contour, relief_side)
+        h, kwargs = validation.engine_arguments(len(picks), step_height, w_int, open_contour, relief_side)
     except ValueError as exc:
         raise EngineError(str(exc)) from None
-    mesh_io.sync_edit_mode(obj)
+    if not flushed:
+        mesh_io.sync_edit_mode(obj)
     vertices, triangles = mesh_io.read_buffers(obj.data)
     if not triangles:
         raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
@@ -117,45 +98,72 @@ def prepare(obj, picks, step_height, *, w_int=0.25, open_contour=False, relief_s
         raise EngineError("Pick %d is not a vertex of %r (it has %d vertices)" % (bad[0], obj.name, nv))
     kwargs["max_iterations"] = int(max_iterations)
     for name, value in (options or {}).items():
-        if name in kwargs or name in ("progress",):
+        if name in kwargs or name in ("progress", "step_height", "picks"):
             raise EngineError("Option %r is a main argument of segment_object(), not an advanced option" % name)
         kwargs[name] = value
-    return {"vertices": vertices, "triangles": triangles, "picks": picks,
-            "step_height": float(step_height), "kwargs": kwargs, "num_vertices": nv,
-            "read_seconds": time.perf_counter() - t0}
+    return Request(vertices, triangles, picks, h, kwargs, key=obj.name_full,
+                   read_seconds=read_seconds + time.perf_counter() - t0)
 
 
-def run(core, job, progress=None):
-    """The engine call; no bpy access, so it may run in a worker thread."""
-    t0 = time.perf_counter()
-    try:
-        result = core.segment(job["vertices"], job["triangles"], job["picks"], job["step_height"],
-                              progress=progress, **job["kwargs"])
-    except (core.Error, TypeError) as exc:  # TypeError: an unknown advanced option
-        raise EngineError(str(exc)) from None
-    result = dict(result)
-    result["timing"] = {"read": job["read_seconds"], "engine": time.perf_counter() - t0, "write": 0.0}
+def mesh_changed(obj, request):
+    """True if obj's mesh data (what the user sees now, Edit Mode included) is not what
+    `request` read: the user edited or undid meanwhile."""
+    from . import mesh_io
+    if obj is None or getattr(obj, "type", None) != 'MESH':
+        return True
+    if mesh_io.live_vertex_count(obj) != request.num_vertices:
+        return True
+    mesh_io.sync_edit_mode(obj)
+    return fingerprint(*mesh_io.read_buffers(obj.data)) != request.digest
+
+
+def segment_object(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
+                   max_iterations=3000, progress=None, write=True, group_name="Relief",
+                   make_curve=True, options=None, cache=MESH_CACHE):
+    """Segment the relief marked by `picks` (vertex indices, in order) on mesh object `obj`.
+
+    step_height: h in object units, or None to let the engine estimate it; w_int: smoothness in
+    (0, 1], or None (the engine chooses; an engine without that choice uses 0.25 and says so in
+    result["notes"]). `options` (dict, optional): the engine's advanced options by name, e.g.
+    {"exact_q": True}; relief_snake_core.advanced_options() lists them. cache: job.MeshCache
+    (default the add-on's) or None.
+
+    Returns the engine's result dict (status, closed, contour [(x, y, z)] in object space,
+    relief_vertices, phases, ...) plus "timing": {"read", "intake", "engine", "write"} seconds
+    and "mesh_cached". Raises EngineError with the engine's one-line message on failure, and
+    relief_snake_core.Cancelled if `progress` returned False. With write=True the vertex group
+    `group_name` and (make_curve) the curve "<obj>_ReliefContour" are filled (reused if they
+    exist); on any failure nothing is written. A status of "doubtful" or "iteration_cap" is
+    written too: summary.status_warning(result) says what to check.
+    """
+    core = load_core()
+    request = prepare(obj, picks, step_height, w_int=w_int, open_contour=open_contour,
+                      relief_side=relief_side, max_iterations=max_iterations, options=options)
+    result = run_engine(core, request, progress, cache)
+    if write:
+        apply_result(obj, result, group_name=group_name, make_curve=make_curve)
     return result
 
 
 def apply_result(obj, result, *, group_name="Relief", make_curve=True):
-    """Write a successful result: vertex group and (optionally) the contour curve.
+    """Write a successful result: vertex group and (optionally) the outline curve.
 
-    Checks first that the mesh still has the vertex count the engine saw."""
+    Checks first that the mesh the user edits still has room for every relief vertex."""
     from . import mesh_io
     t0 = time.perf_counter()
-    relief = result.get("relief_vertices", [])
-    nv = len(obj.data.vertices)
-    if any(not 0 <= i < nv for i in relief):
-        raise EngineError("The mesh changed while segmenting; run Relief Snake again")
-    if not group_name:
+    if not group_name or not group_name.strip():
         raise EngineError("Give the vertex group a name")
+    relief = result.get("relief_vertices", [])
+    nv = mesh_io.live_vertex_count(obj)
+    if any(not 0 <= i < nv for i in relief):
+        raise EngineError("The mesh changed while segmenting; nothing was written: run Segment again")
     contour = result.get("contour", [])
     mesh_io.write_vertex_group(obj, group_name, relief)
     if make_curve and len(contour) >= 2:
         mesh_io.write_curve(obj, contour, result.get("closed", True))
     timing = result.setdefault("timing", {})
     timing["write"] = time.perf_counter() - t0
+    timing["total"] = timing.get("read", 0.0) + timing.get("engine", 0.0) + timing["write"]
     return result
 
 

@@ -1,8 +1,15 @@
-"""Blender mesh data in and out: vertex/triangle buffers, selection and click order,
-the relief vertex group and the contour curve.
+"""Blender mesh data in and out: vertex/triangle buffers, selection and click order, the relief
+vertex group and the contour curve.
 
-Buffers are array.array (Blender 3.4 from Debian has no numpy); foreach_get/foreach_set
-copy straight into them, which is the fast path for 100k+ vertices.
+Buffers are array.array (Blender 3.4 from Debian has no numpy); foreach_get/foreach_set copy
+straight into them, which is the fast path for 100k+ vertices.
+
+Writes go through one path per mode, the one Blender's own tools use, so that undo sees a
+consistent mesh: in Edit Mode the live bmesh (its deform layer) and nothing else, in Object
+Mode the mesh data (VertexGroup.add/remove). An existing group is reused and cleared rather
+than removed and re-created, and an existing contour object keeps its identity: its curve
+data is refilled in place. (Removing and re-creating both in Edit Mode made Blender 3.4
+segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real window.)
 """
 
 from array import array
@@ -10,16 +17,11 @@ from array import array
 import bpy
 import bmesh
 
-__all__ = [
-    "sync_edit_mode",
-    "read_buffers",
-    "read_selection",
-    "vertex_position",
-    "write_vertex_group",
-    "write_curve",
-    "remove_object_and_data",
-    "contour_object_name",
-]
+__all__ = ["sync_edit_mode", "read_buffers", "read_selection", "vertex_position", "live_vertex_count",
+           "write_vertex_group", "write_curve", "contour_object_name", "CONTOUR_COLOR"]
+
+CONTOUR_COLOR = (1.0, 0.32, 0.02, 1.0)  # a clear orange, unlike any of Blender's overlay colours
+_MATERIAL = "Relief Snake Contour"
 
 
 def sync_edit_mode(obj):
@@ -31,9 +33,8 @@ def sync_edit_mode(obj):
 def read_buffers(mesh):
     """Vertices and triangles of a Mesh datablock (no modifiers).
 
-    Returns (vertices, triangles): vertices array('f') flat 3*#V (object space),
-    triangles array('i') flat 3*#T (loop triangles, so n-gons are triangulated the
-    way Blender draws them).
+    Returns (vertices, triangles): vertices array('f') flat 3*#V (object space), triangles
+    array('i') flat 3*#T (loop triangles, so n-gons are triangulated the way Blender draws them).
     """
     nv = len(mesh.vertices)
     vertices = array('f', bytes(12 * nv))
@@ -45,34 +46,44 @@ def read_buffers(mesh):
     return vertices, triangles
 
 
+def _selected_indices(mesh):
+    flags = array('b', bytes(len(mesh.vertices)))
+    mesh.vertices.foreach_get("select", flags)
+    raw = flags.tobytes()
+    out, i = [], raw.find(1)
+    while i >= 0:  # bytes.find skips the unselected runs in C
+        out.append(i)
+        i = raw.find(1, i + 1)
+    return out
+
+
+def _click_order(obj):
+    """Selected vertices in click order (Blender's select history), possibly partial."""
+    mesh = obj.data
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(mesh)  # the live edit mesh: no copy
+        bm.verts.index_update()
+        return [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
+    # Object Mode: the click order is stored with the mesh (MSelect) and only bmesh reads it
+    # back, so this builds a bmesh (the one full copy left on the read path).
+    bm = bmesh.new()
+    try:
+        bm.from_mesh(mesh)
+        return [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
+    finally:
+        bm.free()
+
+
 def read_selection(obj):
     """Selected vertices and their click order.
 
-    Returns (selected, history, positions, normals): selected list[int]; history
-    list[int] in click order (may be partial/empty); positions and normals dicts
-    {index: (x, y, z)} for the selected vertices only (object space).
-    Call sync_edit_mode(obj) first in Edit Mode.
+    Returns (selected, history, positions, normals): selected list[int]; history list[int] in
+    click order (may be partial or empty); positions and normals dicts {index: (x, y, z)} for
+    the selected vertices only (object space). Call sync_edit_mode(obj) first in Edit Mode.
     """
     mesh = obj.data
-    if obj.mode == 'EDIT':
-        bm = bmesh.from_edit_mesh(mesh)
-        own = False
-    else:
-        # Object Mode: the click order is stored with the mesh (MSelect) and
-        # bmesh reads it back into select_history.
-        bm = bmesh.new()
-        bm.from_mesh(mesh)
-        own = True
-    try:
-        bm.verts.index_update()
-        history = [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
-    finally:
-        if own:
-            bm.free()
-    nv = len(mesh.vertices)
-    flags = array('b', bytes(nv))
-    mesh.vertices.foreach_get("select", flags)
-    selected = [i for i, f in enumerate(flags) if f]
+    selected = _selected_indices(mesh)
+    history = _click_order(obj) if selected else []
     verts = mesh.vertices
     positions = {i: tuple(verts[i].co) for i in selected}
     normals = {i: tuple(verts[i].normal) for i in selected}
@@ -84,29 +95,43 @@ def vertex_position(mesh, index):
     return tuple(mesh.vertices[index].co)
 
 
-def write_vertex_group(obj, name, indices):
-    """Put `indices` (weight 1) into vertex group `name`, replacing an older one of that name.
+def live_vertex_count(obj):
+    """The vertex count of what the user edits now: the edit bmesh in Edit Mode."""
+    if obj.mode == 'EDIT':
+        return len(bmesh.from_edit_mesh(obj.data).verts)
+    return len(obj.data.vertices)
 
-    Works in Object and Edit Mode (in Edit Mode through the bmesh deform layer,
-    since VertexGroup.add is refused there). Returns the new group.
+
+def write_vertex_group(obj, name, indices):
+    """Make vertex group `name` hold exactly `indices` (weight 1); reuse the group if it exists.
+
+    Edit Mode: through the edit bmesh's deform layer only; Object Mode: through the mesh data.
+    Returns the group, which becomes the active one.
     """
-    old = obj.vertex_groups.get(name)
-    if old is not None:
-        obj.vertex_groups.remove(old)
-    group = obj.vertex_groups.new(name=name)
+    group = obj.vertex_groups.get(name)
+    if group is None:
+        group = obj.vertex_groups.new(name=name)
+    gi = group.index
     if obj.mode == 'EDIT':
         mesh = obj.data
         bm = bmesh.from_edit_mesh(mesh)
         layer = bm.verts.layers.deform.verify()
-        bm.verts.ensure_lookup_table()
-        gi = group.index
         bverts = bm.verts
+        for v in bverts:  # clear the old members
+            weights = v[layer]
+            if gi in weights:
+                del weights[gi]
+        bverts.ensure_lookup_table()
         for i in indices:
             bverts[i][layer][gi] = 1.0
         bmesh.update_edit_mesh(mesh, loop_triangles=False, destructive=False)
-    elif len(indices):
-        group.add(list(indices), 1.0, 'REPLACE')
-    obj.vertex_groups.active_index = group.index
+    else:
+        nv = len(obj.data.vertices)
+        if nv:
+            group.remove(list(range(nv)))
+        if len(indices):
+            group.add(list(indices), 1.0, 'REPLACE')
+    obj.vertex_groups.active_index = gi
     return group
 
 
@@ -114,24 +139,42 @@ def contour_object_name(obj):
     return obj.name + "_ReliefContour"
 
 
-def remove_object_and_data(ob):
-    """Delete object `ob` and its curve data if nothing else uses it."""
-    data = ob.data
-    bpy.data.objects.remove(ob, do_unlink=True)
-    if isinstance(data, bpy.types.Curve) and data.users == 0:
-        bpy.data.curves.remove(data)
+def _contour_material():
+    mat = bpy.data.materials.get(_MATERIAL)
+    if mat is None:
+        mat = bpy.data.materials.new(_MATERIAL)
+        mat.diffuse_color = CONTOUR_COLOR  # Solid shading's material colour
+        mat.use_nodes = True
+        bsdf = mat.node_tree.nodes.get("Principled BSDF")
+        if bsdf is not None:
+            bsdf.inputs["Base Color"].default_value = CONTOUR_COLOR
+            if "Emission Color" in bsdf.inputs:  # 4.0+
+                bsdf.inputs["Emission Color"].default_value = CONTOUR_COLOR
+            elif "Emission" in bsdf.inputs:
+                bsdf.inputs["Emission"].default_value = CONTOUR_COLOR
+    return mat
 
 
-def write_curve(obj, contour, closed):
-    """A 3D POLY curve through `contour` (list of (x, y, z) in obj's object space),
-    parented to obj with an identity parent inverse so it sits on the mesh wherever
-    obj is. Replaces an older "<obj>_ReliefContour" curve. Returns the new object.
+def write_curve(obj, contour, closed, radius=None):
+    """A 3D POLY curve through `contour` (list of (x, y, z) in obj's object space), parented to
+    obj (identity parent inverse, so it sits on the mesh wherever obj is), drawn as an orange
+    tube of `radius` (default: 0.6 of the mean point spacing) in front of the mesh.
+
+    An existing "<obj>_ReliefContour" curve object is kept and its curve data refilled.
+    Returns the curve object.
     """
     name = contour_object_name(obj)
-    old = bpy.data.objects.get(name)
-    if old is not None and old.type == 'CURVE':
-        remove_object_and_data(old)
-    curve = bpy.data.curves.new(name, 'CURVE')
+    ob = bpy.data.objects.get(name)
+    if ob is not None and ob.type != 'CURVE':
+        ob = None  # the name is taken by something else: make a new one beside it
+    if ob is None:
+        curve = bpy.data.curves.new(name, 'CURVE')
+        ob = bpy.data.objects.new(name, curve)
+        collections = list(obj.users_collection) or [bpy.context.scene.collection]
+        for coll in collections:
+            coll.objects.link(ob)
+    curve = ob.data
+    curve.splines.clear()
     curve.dimensions = '3D'
     spline = curve.splines.new('POLY')
     spline.points.add(len(contour) - 1)
@@ -140,10 +183,19 @@ def write_curve(obj, contour, closed):
         flat.extend((p[0], p[1], p[2], 1.0))
     spline.points.foreach_set("co", flat)
     spline.use_cyclic_u = bool(closed)
-    ob = bpy.data.objects.new(name, curve)
-    collections = list(obj.users_collection) or [bpy.context.scene.collection]
-    for coll in collections:
-        coll.objects.link(ob)
-    ob.parent = obj
+    if radius is None:
+        n = len(contour)
+        length = sum(sum((contour[i][k] - contour[i - 1][k]) ** 2 for k in range(3)) ** 0.5 for i in range(1, n))
+        radius = 0.6 * length / max(1, n - 1)
+    curve.bevel_depth = radius
+    curve.bevel_resolution = 2
+    curve.use_fill_caps = True
+    if not curve.materials:
+        curve.materials.append(_contour_material())
+    ob.color = CONTOUR_COLOR  # Solid shading's object colour, if the viewport uses that
+    ob.show_in_front = True
+    if ob.parent is not obj:
+        ob.parent = obj
     ob.matrix_parent_inverse.identity()  # world = obj.matrix_world @ identity basis
+    ob.matrix_basis.identity()
     return ob

@@ -1,50 +1,42 @@
-"""Operators: mesh.relief_snake_segment and mesh.relief_snake_measure.
+"""Operators: mesh.relief_snake_segment and mesh.relief_snake_measure; thin glue over
+api (read, write) and job (the engine in a worker thread).
 
-Segment runs synchronously from execute() (background mode, scripts calling with
-EXEC_DEFAULT, the redo panel) and as a modal operator from invoke() in an
-interactive session: the engine runs in a worker thread, a window timer polls its
-progress, the viewport shows the evolving snake, Esc cancels. Everything is computed
-before anything is written, so a failure or a cancel leaves the scene untouched.
+Segment runs synchronously from execute() (background mode, scripts calling it with
+EXEC_DEFAULT, the redo panel) and as a modal operator from invoke() in an interactive
+session: the status bar says "Reading mesh..." before the read, the engine runs in a
+job.SegmentJob, a window timer polls its progress, the viewport shows the evolving outline,
+Esc cancels at once. Everything is computed before anything is written, so a failure or a
+cancel leaves the scene untouched. Every modal step runs under try/finally: whatever happens,
+the timer, the draw handler and the status text go away when the run ends.
 """
 
-import threading
-import time
-
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 
-from . import api, ordering, preview
-from .properties import SIDE_ITEMS
+from . import api, job, preview, properties, summary, units
 
-PHASES = ("preprocess", "coarse", "refine", "stabilise")
-_SETTING_NAMES = ("step_height", "w_int", "open_contour", "relief_side", "group_name", "make_curve")
+PHASES = ("intake", "segment", "coarse", "refine", "stabilise")
 
 
 def _settings(context):
     return context.scene.relief_snake
 
 
+def _threads_option(context):
+    prefs = properties.preferences(context)
+    threads = getattr(prefs, "threads", 0) if prefs is not None else 0
+    return {"threads": int(threads)} if threads else {}
+
+
 class MESH_OT_relief_snake_segment(bpy.types.Operator):
-    """Segment the relief outlined by the selected vertices (click order) with the relief snake"""
+    """Outline the relief around the selected vertices (picked in order) and put its vertices in a group"""
     bl_idname = "mesh.relief_snake_segment"
     bl_label = "Segment Relief"
     bl_options = {'REGISTER', 'UNDO'}
 
-    # Unset properties are taken from the scene settings (the Relief panel).
-    step_height: FloatProperty(name="Step Height", default=0.0, min=0.0, precision=4, subtype='DISTANCE',
-                               description="h: height of the relief's step, in object units")
-    w_int: FloatProperty(name="W_int", default=0.25, min=0.01, max=1.0,
-                         description="Internal energy weight during refinement (paper: 0.25)")
-    open_contour: BoolProperty(name="Open Contour", default=False,
-                               description="The contour ends on the mesh boundary")
-    relief_side: EnumProperty(name="Relief Side", items=SIDE_ITEMS, default='LEFT',
-                              description="Open contours: side of the picks the relief is on")
-    group_name: StringProperty(name="Vertex Group", default="Relief",
-                               description="Vertex group receiving the relief vertices (replaced)")
-    make_curve: BoolProperty(name="Contour Curve", default=True,
-                             description="Create a curve object along the contour (replaced)")
+    # The panel's settings; the ones a caller does not set are taken from the scene.
+    __annotations__ = dict(properties.setting_properties())
 
-    _running = False  # one interactive run at a time
+    _modal = None  # the interactive run in progress (one at a time)
 
     @classmethod
     def poll(cls, context):
@@ -55,12 +47,13 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
     # -- shared steps -----------------------------------------------------------------
     def _fill_from_scene(self, context):
         settings = _settings(context)
-        for name in _SETTING_NAMES:
+        for name in properties.SETTING_NAMES:
             if not self.properties.is_property_set(name):
                 setattr(self, name, getattr(settings, name))
 
     def _prepare(self, context):
         """Validate and read everything; raises api.EngineError. Writes nothing."""
+        import time
         obj = context.active_object
         api._mesh_object(obj)
         if not self.group_name.strip():
@@ -68,32 +61,44 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         api.load_core()
         t0 = time.perf_counter()
         picks, info = api.selected_picks(obj)
-        t_select = time.perf_counter() - t0
-        job = api.prepare(obj, picks, self.step_height, w_int=self.w_int, open_contour=self.open_contour,
-                          relief_side=self.relief_side.lower())
-        job["read_seconds"] += t_select  # selection + click order count as data transfer too
-        return obj, job, info
+        request = api.prepare(
+            obj, picks, None if self.estimate_step_height else self.step_height,
+            w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
+            relief_side=self.relief_side.lower(), options=_threads_option(context),
+            read_seconds=time.perf_counter() - t0, flushed=True)  # selection + click order count as data transfer too
+        return obj, request, info
 
     def _finish(self, context, obj, result, info):
         api.apply_result(obj, result, group_name=self.group_name, make_curve=self.make_curve)
         settings = _settings(context)
-        settings.last_summary = ordering.result_summary(result)
-        settings.last_phases = "\n".join(ordering.phase_summary(result) + [ordering.timing_summary(result)])
+        details = summary.phase_lines(result) + [summary.timing_line(result)]
+        h_line = summary.step_height_line(result, lambda v: units.format_length(context.scene, v))
+        if h_line:
+            details.insert(0, h_line)
+            est = result.get("step_height_estimate") or {}
+            if est.get("value"):
+                settings.step_height = float(est["value"])
+        warning = summary.status_warning(result) or ""
+        settings.last_summary = summary.result_summary(result)
+        settings.last_details = "\n".join(details)
+        settings.last_warning = warning
         if info:
             self.report({'INFO'}, info)
         for note in result.get("notes", []):
             self.report({'INFO'}, "Relief Snake: %s" % note)
-        if result.get("status") == "iteration_cap" or str(result.get("status", "")).lower().startswith("iter"):
-            self.report({'WARNING'}, "Relief Snake stopped at the iteration cap; check the contour")
-        self.report({'INFO'}, settings.last_summary)
+        if warning:
+            self.report({'WARNING'}, "Relief Snake: " + warning)
+        if self.show_region and obj.mode == 'EDIT':
+            _show_group_weights(context)
+        self.report({'INFO'}, "Relief Snake: " + settings.last_summary)
         return {'FINISHED'}
 
     # -- synchronous ------------------------------------------------------------------
     def execute(self, context):
         self._fill_from_scene(context)
         try:
-            obj, job, info = self._prepare(context)
-            result = api.run(api.load_core(), job)
+            obj, request, info = self._prepare(context)
+            result = api.run_engine(api.load_core(), request)
             return self._finish(context, obj, result, info)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
@@ -103,49 +108,19 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        if MESH_OT_relief_snake_segment._running:
+        if MESH_OT_relief_snake_segment._modal is not None:
             self.report({'ERROR'}, "Relief Snake is already running: wait for it or press Esc")
             return {'CANCELLED'}
         self._fill_from_scene(context)
-        try:
-            obj, job, info = self._prepare(context)
-            core = api.load_core()
-        except api.EngineError as exc:
-            self.report({'ERROR'}, str(exc))
-            return {'CANCELLED'}
-        self._obj_name, self._info = obj.name, info
-        shared = self._shared = {"phase": "preprocess", "iteration": 0, "snaxels": 0, "contour": None,
-                                 "cancel": False, "cancelled": False, "result": None, "error": None,
-                                 "done": False}
-
-        def progress(phase, iteration, snaxels, contour):
-            # Worker thread: no bpy here, only hand the latest state to the timer.
-            shared["phase"], shared["iteration"], shared["snaxels"] = phase, iteration, snaxels
-            if contour is not None:  # the engine sends it at most every 0.1 s
-                shared["contour"] = contour
-            return not shared["cancel"]
-
-        def work():
-            try:
-                shared["result"] = api.run(core, job, progress)
-            except core.Cancelled:
-                shared["cancelled"] = True
-            except api.EngineError as exc:
-                shared["error"] = str(exc)
-            except Exception as exc:  # keep the UI alive; report instead of a silent thread death
-                shared["error"] = "Relief Snake failed: %s" % exc
-            finally:
-                shared["done"] = True
-
-        self._thread = threading.Thread(target=work, name="relief-snake", daemon=True)
-        MESH_OT_relief_snake_segment._running = True
-        self._thread.start()
+        self._job = None
+        self._obj_name = None
+        self._shown_serial = -1
         wm = context.window_manager
-        self._timer = wm.event_timer_add(0.1, window=context.window)
+        # The read happens on the first timer tick, after the status bar has been drawn.
+        self._timer = wm.event_timer_add(0.05, window=context.window)
         wm.modal_handler_add(self)
-        wm.progress_begin(0, len(PHASES))
-        preview.start()
-        self._status(context, "Relief Snake: preparing... (Esc cancels)")
+        MESH_OT_relief_snake_segment._modal = self
+        self._status(context, "Relief Snake: reading mesh... (Esc cancels)")
         return {'RUNNING_MODAL'}
 
     def _status(self, context, text):
@@ -157,62 +132,106 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         if getattr(self, "_timer", None) is not None:
             wm.event_timer_remove(self._timer)
             self._timer = None
-        wm.progress_end()
+        if getattr(self, "_progress_on", False):
+            wm.progress_end()
+            self._progress_on = False
         preview.stop()
         self._status(context, None)
-        MESH_OT_relief_snake_segment._running = False
+        if MESH_OT_relief_snake_segment._modal is self:
+            MESH_OT_relief_snake_segment._modal = None
         _redraw_views(context)
 
     def modal(self, context, event):
-        shared = self._shared
+        running = False
+        try:
+            ret = self._modal_step(context, event)
+            running = 'RUNNING_MODAL' in ret or 'PASS_THROUGH' in ret
+            return ret
+        except Exception as exc:  # never leave a timer, a draw handler or "already running" behind
+            if self._job is not None:
+                self._job.cancel()
+            self.report({'ERROR'}, "Relief Snake failed: %s: %s" % (type(exc).__name__, exc))
+            return {'CANCELLED'}
+        finally:
+            if not running:
+                self._cleanup(context)
+
+    def _start(self, context):
+        obj, request, info = self._prepare(context)
+        self._obj_name, self._info, self._request = obj.name, info, request
+        self._job = job.SegmentJob(api.load_core(), request).start()
+        prefs = properties.preferences(context)
+        if prefs is not None:
+            preview.set_style(prefs.preview_color, prefs.preview_width)
+        preview.start()
+        context.window_manager.progress_begin(0, len(PHASES))
+        self._progress_on = True
+
+    def _modal_step(self, context, event):
         if event.type == 'ESC' and event.value == 'PRESS':
-            shared["cancel"] = True
-            self._status(context, "Relief Snake: cancelling...")
-            return {'RUNNING_MODAL'}
-        if event.type != 'TIMER':
-            return {'PASS_THROUGH'}  # keep navigating the view while it runs
-        obj = bpy.data.objects.get(self._obj_name)
-        if not shared["done"]:
-            contour = shared["contour"]
-            if contour is not None and obj is not None:
-                preview.set_contour(contour, obj.matrix_world, not self.open_contour)
-            phase = shared["phase"]
-            if phase in PHASES:
-                context.window_manager.progress_update(PHASES.index(phase))
-            if not shared["cancel"]:
-                self._status(context, "Relief Snake: %s, iteration %d, %d snaxels (Esc cancels)"
-                             % (phase, shared["iteration"], shared["snaxels"]))
-            _redraw_views(context)
-            return {'RUNNING_MODAL'}
-        self._thread.join()
-        self._cleanup(context)
-        if shared["cancelled"] or shared["cancel"]:
+            if self._job is not None:
+                self._job.cancel()  # the worker stops at its next progress call; its result is dropped
             self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
             return {'CANCELLED'}
-        if shared["error"]:
-            self.report({'ERROR'}, shared["error"])
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}  # keep navigating the view while it runs
+        if self._job is None:
+            try:
+                self._start(context)
+            except api.EngineError as exc:
+                self.report({'ERROR'}, str(exc))
+                return {'CANCELLED'}
+            return {'RUNNING_MODAL'}
+        obj = bpy.data.objects.get(self._obj_name)
+        run = self._job
+        if not run.done:
+            snap = run.snapshot()
+            if snap.contour is not None and obj is not None and snap.contour_serial != self._shown_serial:
+                preview.set_contour(snap.contour, obj.matrix_world, not self.open_contour)
+                self._shown_serial = snap.contour_serial
+            if snap.stage in PHASES:
+                context.window_manager.progress_update(PHASES.index(snap.stage))
+            words = summary.PHASE_WORDS.get(snap.stage, snap.stage)
+            if snap.stage in ("intake", "segment", "waiting"):
+                text = "Relief Snake: %s, %.0f s (Esc cancels)" % (words, snap.seconds)
+            else:
+                text = "Relief Snake: %s, step %d, %d points (Esc cancels)" % (words, snap.iteration, snap.points)
+            self._status(context, text)
+            _redraw_views(context)
+            return {'RUNNING_MODAL'}
+        if run.cancelled:
+            self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
+            return {'CANCELLED'}
+        if run.error:
+            self.report({'ERROR'}, run.error)
             return {'CANCELLED'}
         if obj is None or obj.type != 'MESH':
             self.report({'ERROR'}, "The object was removed while segmenting; nothing was written")
             return {'CANCELLED'}
+        # PASS_THROUGH let the user edit or undo meanwhile: write only onto the mesh the engine saw.
+        if api.mesh_changed(obj, self._request):
+            self.report({'ERROR'}, "The mesh changed while segmenting; nothing was written: run Segment again")
+            return {'CANCELLED'}
         try:
-            return self._finish(context, obj, shared["result"], self._info)
+            return self._finish(context, obj, run.result, self._info)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
 
     def cancel(self, context):
-        # Blender ends the modal operator (e.g. a file is loaded): stop the worker first.
-        self._shared["cancel"] = True
-        self._thread.join(timeout=30)
+        # Blender ends the modal operator (a file is loaded, the window closes): ask the worker
+        # to stop and return at once; it winds down in the background and its result is dropped.
+        if getattr(self, "_job", None) is not None:
+            self._job.cancel()
         self._cleanup(context)
 
 
 class MESH_OT_relief_snake_measure(bpy.types.Operator):
-    """Set the step height to the distance between the two selected vertices (object space)"""
+    """Set the step height to the distance between the two selected vertices: one at the foot of the step, one on top"""
     bl_idname = "mesh.relief_snake_measure"
     bl_label = "Measure Step Height"
-    bl_options = {'REGISTER', 'UNDO'}
+    # No UNDO: it only sets a panel setting, which the add-on keeps across undo anyway.
+    bl_options = {'REGISTER'}
 
     @classmethod
     def poll(cls, context):
@@ -224,7 +243,7 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
             api._mesh_object(obj)
             from . import mesh_io
             mesh_io.sync_edit_mode(obj)
-            selected, history, _, _ = mesh_io.read_selection(obj)
+            selected, _history, _, _ = mesh_io.read_selection(obj)
             if len(selected) != 2:
                 raise api.EngineError("Select exactly two vertices, one at the foot and one at the top of the "
                                       "step (%d selected)" % len(selected))
@@ -235,9 +254,23 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         if not h > 0:
             self.report({'ERROR'}, "The two selected vertices coincide: pick two vertices apart")
             return {'CANCELLED'}
-        _settings(context).step_height = h
-        self.report({'INFO'}, "Relief Snake: step height set to %.4g" % h)
+        settings = _settings(context)
+        settings.step_height = h
+        settings.estimate_step_height = False
+        self.report({'INFO'}, "Relief Snake: step height set to %s" % units.format_length(context.scene, h))
         return {'FINISHED'}
+
+
+def _show_group_weights(context):
+    """Edit Mode overlay of the active vertex group's weights, in the 3D views of this screen."""
+    screen = context.screen
+    if screen is None:
+        return
+    for area in screen.areas:
+        if area.type == 'VIEW_3D':
+            overlay = getattr(area.spaces.active, "overlay", None)
+            if overlay is not None and hasattr(overlay, "show_weight"):
+                overlay.show_weight = True
 
 
 def _redraw_views(context):

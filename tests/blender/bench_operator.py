@@ -1,13 +1,16 @@
-"""End-to-end time of mesh.relief_snake_segment on a large synthetic scan, split into
-Blender data transfer (selection + foreach_get reads, vertex group + curve writes) and
-engine time. Not part of the test suite; run in either Blender:
+"""End-to-end time of mesh.relief_snake_segment on a large synthetic scan, first click and
+repeat click, split into Blender data transfer (selection + click order + foreach_get reads,
+vertex group + curve writes), engine mesh intake and segmentation. Not part of the test suite
+(it prints numbers, it asserts nothing); run in any of the Blenders:
 
-    blender --background --factory-startup --python tests/blender/bench_operator.py -- [TRIANGLES]
-    .venv-bpy/bin/python tests/blender/bench_operator.py [TRIANGLES]
+    blender --background --factory-startup --python tests/blender/bench_operator.py -- [TRIANGLES] [--edit]
+    .venv-bpy52/bin/python tests/blender/bench_operator.py [TRIANGLES] [--edit]   (RELIEF_SNAKE_MODULE_DIR=build/py313)
 
-Uses $RELIEF_SNAKE_BUILD_DIR (default build/) for make-scan and relief_snake_core.
-The scan is the duck with a blended step (make-scan --step blended, seed 2). "engine" is the
-module call: building the engine's mesh from the buffers (mesh intake) plus the segmentation.
+Uses $RELIEF_SNAKE_BUILD_DIR (default build/) for make-scan and relief_snake_core
+($RELIEF_SNAKE_MODULE_DIR for the module if set). The scan is the duck with a blended step
+(make-scan --step blended, seed 2). --edit runs the operator in Edit Mode (the usual way to
+pick), otherwise in Object Mode. The repeat click finds the engine's Mesh in the add-on's
+cache (same mesh data, same fingerprint): no intake, and the planarity is reused.
 """
 
 import os
@@ -23,12 +26,15 @@ ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 BUILD = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build"))
 
 
+MODULE_DIR = os.environ.get("RELIEF_SNAKE_MODULE_DIR", BUILD)
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
-    transfer_only = "--transfer-only" in argv  # skip the engine (e.g. while it is unfinished)
-    argv = [a for a in argv if a != "--transfer-only"]
+    edit = "--edit" in argv
+    argv = [a for a in argv if a and not a.startswith("--")]
     triangles = int(argv[0]) if argv else 300000
-    sys.path[:0] = [BUILD, os.path.join(ROOT, "addon"), HERE]
+    sys.path[:0] = [MODULE_DIR, os.path.join(ROOT, "addon"), HERE]
     import addon_utils
     import json
     import plyio
@@ -47,70 +53,44 @@ def main():
     obj = bpy.data.objects.new("Scan", mesh)
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.objects.active = obj
+    if edit:
+        bpy.ops.object.mode_set(mode='EDIT')
     select_vertices(obj, truth["picks"])
-
-    want = set(truth["relief_vertices"])
-    got = want
-    if transfer_only:
-        print("bench: Blender %s, %d vertices, %d faces (transfer only, no engine run)"
-              % (bpy.app.version_string, len(mesh.vertices), len(mesh.polygons)))
-    else:
-        got = _run_operator(obj, truth, mesh)
-    api, mesh_io = mod.api, mod.mesh_io
-    contour = [tuple(p) for line in truth["boundary"] for p in line] if isinstance(truth["boundary"][0][0], list) \
-        else [tuple(p) for p in truth["boundary"]]
-    for name, fn in (("selection + click order", lambda: api.selected_picks(obj)),
-                     ("foreach_get vertices + loop triangles", lambda: mesh_io.read_buffers(obj.data)),
-                     ("vertex group write (%d vertices)" % len(got),
-                      lambda: mesh_io.write_vertex_group(obj, "Relief", sorted(got))),
-                     ("curve write (%d points)" % len(contour), lambda: mesh_io.write_curve(obj, contour, True))):
-        best = min(_timed(fn) for _ in range(3))
-        print("bench:   %-40s %.3f s" % (name, best))
+    mesh.calc_loop_triangles()
+    print("bench: Blender %s, %d vertices, %d triangles, %s Mode"
+          % (bpy.app.version_string, len(mesh.vertices), len(mesh.loop_triangles), "Edit" if edit else "Object"))
+    api = mod.api
+    for label in ("first click", "repeat click"):
+        _run_operator(api, obj, truth, label)
     sys.stdout.flush()
     os._exit(0)
 
 
-def _run_operator(obj, truth, mesh):
-    import relief_snake.api as api
+def _run_operator(api, obj, truth, label):
     results = []
-    real_run = api.run
+    real = api.run_engine
 
-    def run(*args, **kwargs):  # keep the operator's result for its exact read/engine/write seconds
-        results.append(real_run(*args, **kwargs))
+    def run_engine(*args, **kwargs):  # keep the operator's result for its read/intake/engine/write seconds
+        results.append(real(*args, **kwargs))
         return results[-1]
-    api.run = run
+    api.run_engine = run_engine
     try:
         t0 = time.perf_counter()
         ret = bpy.ops.mesh.relief_snake_segment('EXEC_DEFAULT', step_height=float(truth["h"]))
         total = time.perf_counter() - t0
     finally:
-        api.run = real_run
-    s = bpy.context.scene.relief_snake
-    gi = obj.vertex_groups["Relief"].index
-    got = {v.index for v in obj.data.vertices if any(g.group == gi for g in v.groups)}
-    want = set(truth["relief_vertices"])
-    print("bench: Blender %s, %d vertices, %d triangles: %s in %.2f s"
-          % (bpy.app.version_string, len(mesh.vertices), len(mesh.loop_triangles), ret, total))
-    print("bench: " + s.last_summary)
-    for line in s.last_phases.splitlines():
-        print("bench:   " + line)
-    score = len(got & want) / max(1, len(got | want))
-    print("bench: IoU %.3f" % score)
-    if results:
-        t = results[-1]["timing"]
-        segmentation = sum(p["seconds"] for p in results[-1]["phases"])
-        intake = results[-1]["seconds"] - segmentation
-        print("bench: SUMMARY total %.2f s = engine %.2f s (mesh intake %.2f s, segmentation %.2f s) + data transfer "
-              "%.2f s (read %.2f s, write %.2f s) + other %.2f s; status %s; IoU %.3f"
-              % (total, t["engine"], intake, segmentation, t["read"] + t["write"], t["read"], t["write"],
-                 total - t["engine"] - t["read"] - t["write"], results[-1].get("status"), score))
-    return got
+        api.run_engine = real
+    r = results[-1]
+    t = r["timing"]
+    segmentation = t["engine"] - t["intake"]
+    transfer = t["read"] + t["write"]
+    other = total - t["engine"] - transfer
+    obj = bpy.data.objects["Scan"]
+    print("bench: %-12s %s total %.2f s = data transfer %.2f s (read %.2f, write %.2f; %.0f%% of the total) "
+          "+ engine %.2f s (mesh intake %.2f, segmentation %.2f; mesh %s) + other %.2f s; status %s"
+          % (label, ret, total, transfer, t["read"], t["write"], 100 * transfer / total, t["engine"], t["intake"],
+             segmentation, "reused" if r["mesh_cached"] else "built", other, r.get("status")))
 
-
-def _timed(fn):
-    t = time.perf_counter()
-    fn()
-    return time.perf_counter() - t
 
 
 if __name__ == "__main__":

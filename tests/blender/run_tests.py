@@ -1,16 +1,14 @@
-"""Runs the add-on test suite inside Blender. One suite, two Blenders:
+"""Runs the add-on test suite inside Blender. One suite, three Blenders:
 
     blender --background --factory-startup --python-exit-code 1 --python tests/blender/run_tests.py
-    .venv-bpy/bin/python tests/blender/run_tests.py
+    .venv-bpy45/bin/python tests/blender/run_tests.py
+    .venv-bpy52/bin/python tests/blender/run_tests.py
 
 It enables the add-on from addon/, puts the built native module (build/relief_snake_core*.so,
 or $RELIEF_SNAKE_BUILD_DIR) on sys.path, writes two synthetic scans with build/make-scan (a
 closed duck relief and an open relief cut by the mesh border) and runs tests/blender/test_*.py.
 Exit status is non-zero when anything fails, when a test is skipped, or when bpy, the native
 module or make-scan is missing: a suite that did not run is a failure.
-
-Development only: RELIEF_SNAKE_FAKE_CORE=1 uses tests/blender/dev/ (a fake engine and a
-Python-made disk scan) and always exits non-zero, so it can never pass for the real thing.
 """
 
 import glob
@@ -25,7 +23,8 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 BUILD = os.environ.get("RELIEF_SNAKE_BUILD_DIR", os.path.join(ROOT, "build"))
-FAKE = os.environ.get("RELIEF_SNAKE_FAKE_CORE") == "1"
+# The module may come from another build of the same sources (bpy 5.2 needs the cp313 one).
+MODULE_DIR = os.environ.get("RELIEF_SNAKE_MODULE_DIR", BUILD)
 
 
 def _exit(code):
@@ -45,18 +44,13 @@ def make_scan(out_dir):
     prefix = os.environ.get("RELIEF_SNAKE_SCAN")
     if not prefix:
         prefix = os.path.join(out_dir, "duck")
-        if FAKE:
-            sys.path.insert(0, os.path.join(HERE, "dev"))
-            import make_disk_scan
-            make_disk_scan.main(prefix)
-        else:
-            tool = os.path.join(BUILD, "make-scan")
-            if not os.path.exists(tool):
-                _fail("%s not found: build it first (make build)" % tool)
-            cmd = [tool, "--shape", "duck", "--background", "plane", "--triangles",
-                   os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "60000"), "--step", "blended",
-                   "--seed", "1", "--out", prefix]
-            subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        tool = os.path.join(BUILD, "make-scan")
+        if not os.path.exists(tool):
+            _fail("%s not found: build it first (make build)" % tool)
+        cmd = [tool, "--shape", "duck", "--background", "plane", "--triangles",
+               os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "60000"), "--step", "blended",
+               "--seed", "1", "--out", prefix]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     with open(prefix + ".truth.json") as f:
         return prefix, json.load(f)
 
@@ -64,9 +58,7 @@ def make_scan(out_dir):
 def make_open_scan(out_dir):
     """The open-contour scan (a relief cut by the mesh's right edge, picks from border to border,
     the relief on their left; the same case as tests/native/test_segment.cpp's open_relief).
-    Returns (prefix, truth dict), or None with the fake engine (it has no open scan)."""
-    if FAKE:
-        return None
+    Returns (prefix, truth dict)."""
     prefix = os.path.join(out_dir, "open")
     cmd = [os.path.join(BUILD, "make-scan"), "--shape", "open", "--background", "plane", "--triangles",
            os.environ.get("RELIEF_SNAKE_TEST_TRIANGLES", "60000"), "--step", "blended", "--seed", "1",
@@ -84,14 +76,12 @@ def main():
     print("run_tests: Blender %s, Python %s" % (bpy.app.version_string, sys.version.split()[0]))
 
     # The native module, where the add-on's fallback `import relief_snake_core` finds it.
-    if FAKE:
-        sys.path.insert(0, os.path.join(HERE, "dev"))
-        print("run_tests: *** FAKE ENGINE (development only); this run will exit non-zero ***")
-    else:
-        found = glob.glob(os.path.join(BUILD, "relief_snake_core*.so"))
-        if not found:
-            _fail("native module relief_snake_core not found in %s: build it (make build)" % BUILD)
-        sys.path.insert(0, BUILD)
+    import sysconfig
+    module = os.path.join(MODULE_DIR, "relief_snake_core" + sysconfig.get_config_var("EXT_SUFFIX"))
+    if not glob.glob(module):
+        _fail("native module %s not found: build it for Python %d.%d (make build, or "
+              "scripts/build-wheel.sh --python313)" % (module, *sys.version_info[:2]))
+    sys.path.insert(0, MODULE_DIR)
     try:
         import relief_snake_core
     except ImportError as exc:
@@ -113,11 +103,11 @@ def main():
     open_scan = make_open_scan(tmp)
     sys.path.insert(0, HERE)
     import test_addon
-    test_addon.configure(prefix, truth, fake=FAKE, open_scan=open_scan)
+    test_addon.configure(prefix, truth, open_scan=open_scan)
 
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()
-    for name in ("test_ordering", "test_addon", "test_extraction"):
+    for name in ("test_pick_order", "test_validation", "test_summary", "test_job", "test_addon", "test_extraction"):
         suite.addTests(loader.loadTestsFromName(name))
     t0 = time.perf_counter()
     result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)
@@ -127,8 +117,6 @@ def main():
         _fail("%d test(s) skipped; a skipped test counts as a failure" % len(result.skipped))
     if not result.wasSuccessful() or result.testsRun == 0:
         _fail("%d failure(s), %d error(s)" % (len(result.failures), len(result.errors)))
-    if FAKE:
-        _fail("fake engine used: the plumbing passed, but this is not a valid run")
     print("run_tests: OK")
     _exit(0)
 

@@ -1,4 +1,4 @@
-"""bpy-free tests of addon/relief_snake/ordering.py (plain Python: pytest, and inside both Blenders)."""
+"""bpy-free tests of addon/relief_snake/pick_order.py (plain Python: pytest, and inside both Blenders)."""
 
 import math
 import os
@@ -8,7 +8,7 @@ import unittest
 
 _ADDON = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "addon", "relief_snake")
 sys.path.insert(0, os.path.normpath(_ADDON))
-import ordering  # noqa: E402  (bpy-free module, imported standalone on purpose)
+import pick_order as ordering  # noqa: E402  (bpy-free module, imported standalone on purpose)
 
 
 def _ring(k, radius=1.0, tilt=0.0, centre=(0.3, -0.2, 0.5)):
@@ -93,35 +93,7 @@ class OrderPicks(unittest.TestCase):
         self.assertIsNone(info)
 
 
-class ValidateAndSummaries(unittest.TestCase):
-    def test_validate_options(self):
-        kw = ordering.validate_options(4, 1.5, 0.3, False, 'RIGHT')
-        self.assertEqual(kw, {"w_int": 0.3, "open_contour": False, "relief_side": "right"})
-        self.assertEqual(ordering.validate_options(2, 1.0, open_contour=True)["open_contour"], True)
-        for args in [(2, 1.0), (0, 1.0), (3, 0.0), (3, -1.0), (3, float("nan")), (3, float("inf"))]:
-            with self.assertRaises(ValueError):
-                ordering.validate_options(*args)
-        with self.assertRaises(ValueError):
-            ordering.validate_options(1, 1.0, open_contour=True)
-        with self.assertRaises(ValueError):
-            ordering.validate_options(3, 1.0, w_int=0.0)
-        with self.assertRaises(ValueError):
-            ordering.validate_options(3, 1.0, relief_side="up")
-
-    def test_summaries(self):
-        result = {"status": "converged", "closed": True, "contour": [(0, 0, 0)] * 5,
-                  "relief_vertices": [1, 2, 3], "seconds": 2.5,
-                  "phases": [{"name": "coarse", "iterations": 131, "snaxels": 175, "seconds": 21.04,
-                              "converged": True},
-                             {"name": "refine", "iterations": 3000, "snaxels": 900, "seconds": 60.0,
-                              "converged": False}]}
-        self.assertEqual(ordering.phase_summary(result),
-                         ["coarse: 131 it, 175 snaxels, 21.04 s", "refine: 3000 it, 900 snaxels, 60.00 s (cap)"])
-        s = ordering.result_summary(result)
-        self.assertIn("converged", s)
-        self.assertIn("5 snaxels", s)
-        self.assertIn("3 relief vertices", s)
-
+class Distance(unittest.TestCase):
     def test_distance(self):
         self.assertAlmostEqual(ordering.distance((0, 0, 0), (3, 4, 12)), 13.0)
 

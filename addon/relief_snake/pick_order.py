@@ -1,20 +1,9 @@
-"""bpy-free logic of the add-on: ordering picks, validating options, summarising results.
-
-Nothing here imports bpy, so it is tested with plain Python (tests/blender/test_ordering.py)
-as well as inside both Blenders.
-"""
+"""The order of the picks: the click order Blender recorded, or, when it is missing or
+partial, the angle around the picks' centroid. bpy-free (tests/blender/test_pick_order.py)."""
 
 import math
 
-__all__ = [
-    "order_picks",
-    "order_by_angle",
-    "validate_options",
-    "phase_summary",
-    "result_summary",
-    "timing_summary",
-    "distance",
-]
+__all__ = ["order_picks", "order_by_angle", "distance"]
 
 
 def _sub(a, b):
@@ -118,49 +107,3 @@ def order_picks(selected, history, positions, normals=None):
         why = "no click order recorded"
     return picks, ("Relief Snake: %s; ordered the %d picks by angle around their centroid"
                    % (why, len(selected)))
-
-
-def validate_options(num_picks, step_height, w_int=0.25, open_contour=False, relief_side="LEFT"):
-    """Check operator options before any work; returns the engine keyword arguments.
-
-    Raises ValueError with a one-line message saying what to do.
-    """
-    need = 2 if open_contour else 3
-    if num_picks < need:
-        raise ValueError(
-            "Select at least %d vertices around the relief (%s contour); %d selected"
-            % (need, "an open" if open_contour else "a closed", num_picks))
-    if not (step_height > 0 and math.isfinite(step_height)):
-        raise ValueError("Step height must be > 0: set it in the Relief panel or measure it from two vertices")
-    if not (0 < w_int <= 1):
-        raise ValueError("W_int must be in (0, 1]; the paper uses 0.25")
-    side = str(relief_side).lower()
-    if side not in ("left", "right"):
-        raise ValueError("Relief side must be LEFT or RIGHT")
-    return {"w_int": float(w_int), "open_contour": bool(open_contour), "relief_side": side}
-
-
-def phase_summary(result):
-    """One line per phase: 'coarse: 131 it, 175 snaxels, 21.0 s'."""
-    lines = []
-    for p in result.get("phases", []):
-        lines.append("%s: %d it, %d snaxels, %.2f s%s" % (
-            p.get("name", "?"), int(p.get("iterations", 0)), int(p.get("snaxels", 0)),
-            float(p.get("seconds", 0.0)), "" if p.get("converged", True) else " (cap)"))
-    return lines
-
-
-def result_summary(result):
-    """A one-line report of a segmentation result dict (see relief_snake_core.segment)."""
-    contour = result.get("contour", [])
-    relief = result.get("relief_vertices", [])
-    return "Relief Snake: %s, %d snaxels (%s), %d relief vertices, %.2f s" % (
-        result.get("status", "?"), len(contour), "closed" if result.get("closed", True) else "open",
-        len(relief), float(result.get("seconds", 0.0)))
-
-
-def timing_summary(result):
-    """'Blender data: read 0.12 s, write 0.03 s; engine 4.20 s' from result["timing"] (add-on side)."""
-    t = result.get("timing", {})
-    return "Blender data: read %.2f s, write %.2f s; engine %.2f s" % (
-        float(t.get("read", 0.0)), float(t.get("write", 0.0)), float(t.get("engine", 0.0)))

@@ -1,0 +1,48 @@
+"""bpy-free tests of addon/relief_snake/summary.py: plain words, and the engine's doubts shown."""
+
+import unittest
+
+import _addon_path  # noqa: F401
+import summary  # noqa: E402
+
+RESULT = {"status": "converged", "closed": True, "contour": [(0, 0, 0)] * 5, "relief_vertices": [1, 2, 3],
+          "seconds": 2.5,
+          "phases": [{"name": "coarse", "iterations": 131, "snaxels": 175, "seconds": 21.04, "converged": True},
+                     {"name": "refine", "iterations": 3000, "snaxels": 900, "seconds": 60.0, "converged": False}],
+          "timing": {"read": 0.1, "write": 0.02, "engine": 2.3}}
+
+
+class Summaries(unittest.TestCase):
+    def test_plain_words(self):
+        s = summary.result_summary(RESULT)
+        self.assertEqual(s, "Done: closed outline of 5 points, 3 relief vertices, 2.5 s")
+        self.assertNotIn("snaxel", " ".join(summary.phase_lines(RESULT)))
+        self.assertEqual(summary.phase_lines(RESULT),
+                         ["Coarse pass: 131 steps, 175 points, 21.04 s",
+                          "Refining: 3000 steps, 900 points, 60.00 s (step limit)"])
+        self.assertEqual(summary.timing_line(dict(RESULT, mesh_cached=True)),
+                         "Blender data 0.12 s (read 0.10, write 0.02), engine 2.30 s (mesh reused)")
+
+    def test_converged_has_no_warning(self):
+        self.assertIsNone(summary.status_warning(RESULT))
+
+    def test_doubtful_shows_the_engines_message_and_reasons(self):
+        r = dict(RESULT, status="doubtful", message="The outline may have leaked into the background",
+                 reasons=["the region touches the mesh border", "h looks too small"])
+        w = summary.status_warning(r)
+        self.assertIn("may have leaked", w)
+        self.assertIn("touches the mesh border; h looks too small", w)
+        self.assertIn("done, but doubtful", summary.result_summary(r).lower())
+
+    def test_iteration_cap_without_message_still_warns(self):
+        self.assertIn("step limit", summary.status_warning(dict(RESULT, status="iteration_cap")))
+
+    def test_estimated_step_height_line(self):
+        r = dict(RESULT, step_height_estimate={"value": 0.8125, "confidence": 0.9})
+        self.assertEqual(summary.step_height_line(r, lambda v: "%.3f m" % v),
+                         "Estimated step height: 0.812 m (confidence 0.90)")
+        self.assertIsNone(summary.step_height_line(RESULT))
+
+
+if __name__ == "__main__":
+    unittest.main()
