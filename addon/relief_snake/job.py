@@ -150,7 +150,9 @@ def run_engine(core, request, progress=None, cache=MESH_CACHE, on_stage=None):
         raise core.Cancelled("segmentation cancelled")
     result["notes"] = list(result.get("notes", [])) + notes
     result["mesh_cached"] = cached
-    result["timing"] = {"read": request.read_seconds, "intake": t1 - t0, "engine": t2 - t0, "write": 0.0}
+    # The engine's own timing (load_seconds, segment_seconds) plus the add-on's side of it.
+    result["timing"] = dict(result.get("timing") or {}, read=request.read_seconds, intake=t1 - t0,
+                            engine=t2 - t0, write=0.0)
     return result
 
 

@@ -75,9 +75,9 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         h_line = summary.step_height_line(result, lambda v: units.format_length(context.scene, v))
         if h_line:
             details.insert(0, h_line)
-            est = result.get("step_height_estimate") or {}
-            if est.get("value"):
-                settings.step_height = float(est["value"])
+            used = (result.get("step_height") or {}).get("used")
+            if used:
+                settings.step_height = float(used)
         warning = summary.status_warning(result) or ""
         settings.last_summary = summary.result_summary(result)
         settings.last_details = "\n".join(details)

@@ -31,7 +31,8 @@ def result_summary(result):
     relief = result.get("relief_vertices", [])
     status = str(result.get("status", "?"))
     words = STATUS_WORDS.get(status, status.replace("_", " "))
-    seconds = float(result.get("timing", {}).get("total", result.get("seconds", 0.0)))
+    timing = result.get("timing", {})
+    seconds = float(timing.get("total", timing.get("segment_seconds", 0.0)))
     return "%s: %s outline of %d points, %d relief vertices, %.1f s" % (
         words[:1].upper() + words[1:], "closed" if result.get("closed", True) else "open",
         len(contour), len(relief), seconds)
@@ -57,13 +58,15 @@ def status_warning(result):
 
 
 def step_height_line(result, format_length=str):
-    """'Estimated step height: 0.81 m (confidence 0.9)' when the engine estimated h, else None."""
-    est = result.get("step_height_estimate")
-    if not isinstance(est, dict) or "value" not in est:
+    """'Estimated step height: 0.81 m (confidence 0.9)' when the engine estimated h, else None.
+
+    The result's step_height is {"used", "given", "estimate", "confidence"} (docs/result-format.md)."""
+    sh = result.get("step_height")
+    if not isinstance(sh, dict) or sh.get("given") is not None or not sh.get("used"):
         return None
-    line = "Estimated step height: %s" % format_length(float(est["value"]))
-    if est.get("confidence") is not None:
-        line += " (confidence %.2f)" % float(est["confidence"])
+    line = "Estimated step height: %s" % format_length(float(sh["used"]))
+    if sh.get("confidence") is not None:
+        line += " (confidence %.2f)" % float(sh["confidence"])
     return line
 
 

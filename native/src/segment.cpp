@@ -210,6 +210,24 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       result.notes.push_back("the open contour's ends were extended to the mesh boundary");
   }
 
+  // Front ends show "preprocessing" before the estimate and the planarity (seconds on big scans),
+  // and can cancel there.
+  auto preprocessing = [&](int step) {
+    if (!progress) return true;
+    Progress p;
+    p.phase = "preprocess";
+    p.iteration = step;
+    p.contour = [] { return std::vector<Vec3>{}; };
+    return progress(p);
+  };
+  auto cancelled_result = [&] {
+    Result out;
+    out.status = Status::Cancelled;
+    out.closed = options.closed;
+    return out;
+  };
+  if (!preprocessing(0)) return cancelled_result();
+
   // --- step height and relief side --------------------------------------------
   const bool h_given = options.step_height > 0;
   const bool side_given = options.closed || options.relief_side != ReliefSide::Auto;
@@ -245,6 +263,10 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     Attempt best;
     best.h = h_try;
     const auto t_pre = Clock::now();
+    if (!preprocessing(1)) {
+      cancelled = true;
+      return best;
+    }
     std::vector<SurfacePoint> start = resample_path(mesh, initial.path, h_try, options.closed);
     if (static_cast<int>(start.size()) < (options.closed ? 4 : 3)) {
       best.run.collapsed = true;

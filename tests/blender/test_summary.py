@@ -6,10 +6,10 @@ import _addon_path  # noqa: F401
 import summary  # noqa: E402
 
 RESULT = {"status": "converged", "closed": True, "contour": [(0, 0, 0)] * 5, "relief_vertices": [1, 2, 3],
-          "seconds": 2.5,
+          "step_height": {"used": 1.0, "given": 1.0, "estimate": None, "confidence": 1.0},
           "phases": [{"name": "coarse", "iterations": 131, "snaxels": 175, "seconds": 21.04, "converged": True},
                      {"name": "refine", "iterations": 3000, "snaxels": 900, "seconds": 60.0, "converged": False}],
-          "timing": {"read": 0.1, "write": 0.02, "engine": 2.3}}
+          "timing": {"load_seconds": 0.2, "segment_seconds": 2.5, "read": 0.1, "write": 0.02, "engine": 2.3}}
 
 
 class Summaries(unittest.TestCase):
@@ -38,7 +38,7 @@ class Summaries(unittest.TestCase):
         self.assertIn("step limit", summary.status_warning(dict(RESULT, status="iteration_cap")))
 
     def test_estimated_step_height_line(self):
-        r = dict(RESULT, step_height_estimate={"value": 0.8125, "confidence": 0.9})
+        r = dict(RESULT, step_height={"used": 0.8125, "given": None, "estimate": 0.79, "confidence": 0.9})
         self.assertEqual(summary.step_height_line(r, lambda v: "%.3f m" % v),
                          "Estimated step height: 0.812 m (confidence 0.90)")
         self.assertIsNone(summary.step_height_line(RESULT))

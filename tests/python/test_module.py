@@ -469,6 +469,9 @@ def test_progress_arguments(scan):
     for phase, iteration, snaxels, contour in calls:
         assert isinstance(phase, str) and phase in PHASES
         assert isinstance(iteration, int) and iteration >= 0
+        if phase == "preprocess":  # before the snake exists: h estimate and planarity
+            assert snaxels == 0 and contour in (None, [])
+            continue
         assert isinstance(snaxels, int) and snaxels > 0
         if phase not in seen_phases:  # every phase's first call carries the contour
             assert contour is not None
