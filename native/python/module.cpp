@@ -157,7 +157,8 @@ std::vector<Out> read_buffer(py::handle obj, Kind kind, const char* what, bool r
   char code = 0;
   bool native = true;
   if (!parse_format(info.format, &code, &native) || !(kind == Kind::Float ? is_float_code(code) : is_int_code(code)))
-    throw InputTypeError(std::string(what) + " must be " + type_words(kind) + ", got buffer format '" + info.format +
+    throw InputTypeError(std::string(what) + " must be " + type_words(kind) + ", got a " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))) + " of buffer format '" + info.format +
                          "'; convert it (e.g. array.array('" + (kind == Kind::Float ? "d" : "q") + "', ...))");
   if (!native) throw Error(std::string(what) + " is big-endian; convert it to native byte order first");
   if (!rows_of_three && info.ndim != 1)
@@ -253,8 +254,7 @@ py::object sequence_item(py::handle seq, std::size_t i, const std::string& where
 template <class Out>
 std::vector<Out> read_array(py::handle obj, Kind kind, const char* what, bool rows_of_three) {
   if (obj.is_none()) throw InputTypeError(std::string(what) + " is None; pass an array or a list of rows");
-  if (PyObject_CheckBuffer(obj.ptr()) && !PyBytes_Check(obj.ptr()) && !PyByteArray_Check(obj.ptr()))
-    return read_buffer<Out>(obj, kind, what, rows_of_three);
+  if (PyObject_CheckBuffer(obj.ptr())) return read_buffer<Out>(obj, kind, what, rows_of_three);
   if (!is_sequence(obj))
     throw InputTypeError(std::string(what) + " must be a buffer (array.array, numpy) or a sequence, got " + shown(obj));
   const py::object seq = py::reinterpret_borrow<py::object>(obj);  // held for the whole read
