@@ -253,6 +253,12 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   }
   result.relief_side = inside_left ? ReliefSide::Left : ReliefSide::Right;
 
+  // With the refit on, a kept result's step must agree with its own h within x1.5: the refit
+  // brings a right contour's h within x1.3, and a contour whose step keeps moving away from
+  // its h is on something else (texture, detail).
+  SelfCheckOptions self_check;
+  if (options.refit_step_height) self_check.max_step_ratio = std::max(1.5, options.refit_ratio * 1.15);
+
   // --- attempts: schedule -> foot -> region -> self-check, for each h and W_int tried
   const std::vector<double> w_steps =
       options.w_int > 0 ? std::vector<double>{options.w_int} : std::vector<double>{0.25, 0.5, 1.0};
@@ -347,7 +353,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         const std::vector<char> other = relief_region(mesh, a.run.contour, false, !inside_left);
         a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try).step_share;
       }
-      a.check = judge(a.evidence, h_try);
+      a.check = judge(a.evidence, h_try, self_check);
       const bool holds = a.check.holds;
       if (first || better(a, best)) best = std::move(a);
       first = false;

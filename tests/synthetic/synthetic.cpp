@@ -458,8 +458,10 @@ Vec3 Scan::background_normal(double u, double v) const {
 }
 
 int Scan::nearest_vertex(double u, double v) const {
-  const int i0 = static_cast<int>(std::lround((u + 0.5 * spec.width) / spacing_u));
-  const int j0 = static_cast<int>(std::lround((v + 0.5 * spec.height) / spacing_v));
+  // Clamped into the grid: a point off the domain (a zigzag ring's far corner) gets the nearest
+  // border vertex instead of no vertex at all.
+  const int i0 = std::clamp(static_cast<int>(std::lround((u + 0.5 * spec.width) / spacing_u)), 0, grid_u - 1);
+  const int j0 = std::clamp(static_cast<int>(std::lround((v + 0.5 * spec.height) / spacing_v)), 0, grid_v - 1);
   int best = -1;
   double best_d = std::numeric_limits<double>::infinity();
   for (int j = std::max(0, j0 - 2); j <= std::min(grid_v - 1, j0 + 2); ++j)
