@@ -605,7 +605,10 @@ TEST(SyntheticRandom, ScansAreConsistentWithTheirTruth) {
     EXPECT_NEAR(static_cast<double>(s.n_faces()), static_cast<double>(s.spec.triangles), 0.02 * s.spec.triangles);
     // Relief flags are the silhouette; picks lie outside it, on the background.
     for (std::size_t v = 0; v < s.n_vertices(); v += 7) ASSERT_EQ(s.relief[v] != 0, sd_at(s, v) < 0);
-    for (std::int64_t p : r.picks.vertices) EXPECT_GT(sd_at(s, p), 0.5 * s.h) << "pick " << p;
+    for (std::int64_t p : r.picks.vertices) {
+      ASSERT_GE(p, 0);
+      EXPECT_GT(sd_at(s, p), 0.5 * s.h) << "pick " << p;
+    }
     // Each vertex is its base plus the three heights along the background normal.
     for (std::size_t v = 0; v < s.n_vertices(); v += 5) {
       const double u = s.UV[2 * v], w = s.UV[2 * v + 1];
@@ -686,4 +689,21 @@ TEST(SyntheticRandom, OneEdgeFloorMatchesAnOffsetRegion) {
   }
   ASSERT_GT(grown, truth);
   EXPECT_NEAR(floor.vertices, static_cast<double>(truth) / grown, 1e-12);
+}
+
+TEST(SyntheticRandom, NearestVertexOnAGradedTriangulation) {
+  ScanSpec spec = make_spec(Shape::Disk, Background::Plane, 20000);
+  spec.grade_u = 0.35;
+  spec.grade_v = 0.3;
+  const Scan s = generate(spec);
+  for (std::size_t v = 0; v < s.n_vertices(); v += 37) {
+    const double u = s.UV[2 * v] + 0.1 * s.spacing_u, w = s.UV[2 * v + 1] - 0.1 * s.spacing_v;
+    std::size_t best = 0;
+    double best_d = 1e300;
+    for (std::size_t k = 0; k < s.n_vertices(); ++k) {
+      const double d = std::hypot(s.UV[2 * k] - u, s.UV[2 * k + 1] - w);
+      if (d < best_d) best_d = d, best = k;
+    }
+    ASSERT_EQ(s.nearest_vertex(u, w), static_cast<int>(best)) << "vertex " << v;
+  }
 }

@@ -318,6 +318,12 @@ RandomScan generate_random(std::uint64_t seed) {
         if (picks.closed && kept.size() > 1 && kept.front() == kept.back()) kept.pop_back();
         picks.vertices = kept;
       }
+      bool valid = picks.vertices.size() >= (picks.closed ? 3u : 2u);
+      for (std::int64_t p : picks.vertices) valid = valid && p >= 0;
+      if (!valid) {
+        last_error = "a pick did not land on a vertex";
+        continue;
+      }
       RandomScan out;
       out.draw = std::move(draw);
       out.scan = std::move(scan);

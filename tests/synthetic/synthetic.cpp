@@ -457,11 +457,33 @@ Vec3 Scan::background_normal(double u, double v) const {
   return Vec3(0, 0, 1);
 }
 
+namespace {
+// Inverse of generate()'s graded warp x - g L / (2 pi) sin(2 pi x / L) (Newton; its slope is >= 1 - g).
+double unwarp(double y, double L, double g) {
+  double x = y;
+  for (int it = 0; it < 30; ++it) {
+    const double f = x - g * L / (2 * M_PI) * std::sin(2 * M_PI * x / L) - y;
+    x -= f / (1 - g * std::cos(2 * M_PI * x / L));
+    if (std::abs(f) < 1e-12 * L) break;
+  }
+  return x;
+}
+}  // namespace
+
+double Scan::grid_column(double u) const {
+  const double x = u + 0.5 * spec.width;
+  return (spec.grade_u > 0 ? unwarp(x, spec.width, spec.grade_u) : x) / spacing_u;
+}
+double Scan::grid_row(double v) const {
+  const double y = v + 0.5 * spec.height;
+  return (spec.grade_v > 0 ? unwarp(y, spec.height, spec.grade_v) : y) / spacing_v;
+}
+
 int Scan::nearest_vertex(double u, double v) const {
   // Clamped into the grid: a point off the domain (a zigzag ring's far corner) gets the nearest
   // border vertex instead of no vertex at all.
-  const int i0 = std::clamp(static_cast<int>(std::lround((u + 0.5 * spec.width) / spacing_u)), 0, grid_u - 1);
-  const int j0 = std::clamp(static_cast<int>(std::lround((v + 0.5 * spec.height) / spacing_v)), 0, grid_v - 1);
+  const int i0 = std::clamp(static_cast<int>(std::lround(grid_column(u))), 0, grid_u - 1);
+  const int j0 = std::clamp(static_cast<int>(std::lround(grid_row(v))), 0, grid_v - 1);
   int best = -1;
   double best_d = std::numeric_limits<double>::infinity();
   for (int j = std::max(0, j0 - 2); j <= std::min(grid_v - 1, j0 + 2); ++j)
@@ -785,8 +807,8 @@ Picks Scan::picks(const PickSpec& ps) const {
   auto snap = [&](const Vec2& p, bool on_boundary) {
     if (!on_boundary) return nearest_vertex(p.x(), p.y());
     // Ends of an open ring lie on the domain edge: take the nearest mesh-boundary vertex.
-    const int i0 = static_cast<int>(std::lround((p.x() + 0.5 * W) / spacing_u));
-    const int j0 = static_cast<int>(std::lround((p.y() + 0.5 * H) / spacing_v));
+    const int i0 = static_cast<int>(std::lround(grid_column(p.x())));
+    const int j0 = static_cast<int>(std::lround(grid_row(p.y())));
     int best = -1;
     double best_d = 1e300;
     for (int j = std::max(0, j0 - 2); j <= std::min(grid_v - 1, j0 + 2); ++j)

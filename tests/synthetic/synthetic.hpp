@@ -186,6 +186,9 @@ struct Scan {
   Vec3 background_normal(double u, double v) const;
   /// Nearest mesh vertex to (u, v) in the parameter plane.
   int nearest_vertex(double u, double v) const;
+  /// Fractional grid column / row of the vertices near u / v (undoes the graded warp).
+  double grid_column(double u) const;
+  double grid_row(double v) const;
 
   /// Suggested picks; throws Error if the requested ring does not fit in the domain.
   Picks picks(const PickSpec& pick_spec = {}) const;
