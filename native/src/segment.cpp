@@ -66,6 +66,11 @@ void validate_options(const Mesh& mesh, const Options& o) {
   if (!std::isfinite(h) || h < 0)
     throw Error("step height h must be a positive number, or auto (got " + fmt(h) +
                 "); measure the relief's step with the measure tool");
+  // A step far below the mesh's resolution cannot be resolved, and the snake would need
+  // (length / h) snaxels: refuse instead of running away.
+  if (h > 0 && h < 0.1 * mesh.average_edge_length())
+    throw Error("step height h = " + fmt(h) + " is below a tenth of the mesh's average edge (" +
+                fmt(mesh.average_edge_length()) + "); check the units of h, or leave it to the engine");
   if (h > mesh.bbox_diagonal())
     throw Error("step height h = " + fmt(h) + " is larger than the whole mesh (diagonal " +
                 fmt(mesh.bbox_diagonal()) + "); check the units of h");
@@ -245,8 +250,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       if (!(estimate.value > 0))
         throw Error("could not estimate the step height: nothing rises above the background inside the picked "
                     "contour; give h (measure the step) or pick around the relief");
-      h = estimate.value;
-      if (h > mesh.bbox_diagonal()) h = mesh.bbox_diagonal() / 4;
+      // Kept within what the mesh can resolve and hold (the self-check judges the rest).
+      h = std::clamp(estimate.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
       result.step_height_estimate = h;
       result.step_height_confidence = estimate.confidence;
     }

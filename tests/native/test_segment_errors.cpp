@@ -76,6 +76,8 @@ TEST(SegmentErrors, BadStepHeight) {
   for (double h : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
     EXPECT_NE(error_of(mesh, kRing, with_h(h)).find("step height"), std::string::npos) << h;
   EXPECT_NE(error_of(mesh, kRing, with_h(1000.0)).find("larger than the whole mesh"), std::string::npos);
+  // Far below the mesh's resolution: refused (the snake would need length / h snaxels).
+  EXPECT_NE(error_of(mesh, kRing, with_h(1e-4)).find("below a tenth of the mesh's average edge"), std::string::npos);
 }
 
 TEST(SegmentErrors, WIntOutsideZeroOne) {
