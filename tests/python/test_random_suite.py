@@ -52,14 +52,36 @@ def describe(row):
             f"{s.get('mean_from_truth', float('nan')):.2f} edges")
 
 
+# Issue 14 is not done: on this sample the engine of December 2026 returns one wrong result as
+# converged (seed-1010, an open band with a drop profile whose region takes in the background) and is
+# accurate on 17 of 20. The contract stays as written, marked as the known failure it is (strict: the
+# day it passes, this mark must go); test_no_worse_than_measured below guards against regressions.
+KNOWN_FAILURE = pytest.mark.xfail(strict=True, reason="issue 14 open: seed-1010 silent, 17/20 accurate")
+
+
+@KNOWN_FAILURE
 def test_every_wrong_result_is_flagged(sample):
     silent = [r for r in sample if not r["accurate"] and not r["flagged"]]
     assert not silent, "wrong results reported as converged:\n" + "\n".join(describe(r) for r in silent)
 
 
+@KNOWN_FAILURE
 def test_most_results_are_accurate(sample):
     accurate = sum(r["accurate"] for r in sample)
     wrong = [r for r in sample if not r["accurate"]]
     assert accurate >= MIN_ACCURATE * len(sample), (
         f"{accurate} of {len(sample)} accurate (wanted >= {MIN_ACCURATE:.0%}); wrong:\n"
         + "\n".join(describe(r) + f" [{r['outcome']}]" for r in wrong))
+
+
+# What the engine achieved on this sample when the marks above were set; any regression fails.
+MEASURED_ACCURATE = 17
+MEASURED_SILENT = 1
+
+
+def test_no_worse_than_measured(sample):
+    accurate = sum(r["accurate"] for r in sample)
+    silent = [r for r in sample if not r["accurate"] and not r["flagged"]]
+    assert accurate >= MEASURED_ACCURATE and len(silent) <= MEASURED_SILENT, (
+        f"{accurate} of {len(sample)} accurate (measured {MEASURED_ACCURATE}), {len(silent)} silent "
+        f"(measured {MEASURED_SILENT}):\n" + "\n".join(describe(r) for r in silent))
