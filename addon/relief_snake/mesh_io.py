@@ -184,9 +184,13 @@ def write_curve(obj, contour, closed, radius=None):
     spline.points.foreach_set("co", flat)
     spline.use_cyclic_u = bool(closed)
     if radius is None:
+        # Thick enough to read at the zoom that shows the whole outline (0.6% of its size), and
+        # never thinner than its own point spacing: the refinement's half-edge spacing alone gave
+        # a hairline that read as dashed over the Edit Mode mesh.
         n = len(contour)
         length = sum(sum((contour[i][k] - contour[i - 1][k]) ** 2 for k in range(3)) ** 0.5 for i in range(1, n))
-        radius = 0.6 * length / max(1, n - 1)
+        size = sum((max(p[k] for p in contour) - min(p[k] for p in contour)) ** 2 for k in range(3)) ** 0.5
+        radius = max(0.6 * length / max(1, n - 1), 0.006 * size)
     curve.bevel_depth = radius
     curve.bevel_resolution = 2
     curve.use_fill_caps = True

@@ -481,8 +481,11 @@ def scenario_artist():
         if not job_running():
             break
         yield 0.3
+        # Running when the screenshot was asked for (the run may end while it is taken; the cyan
+        # preview is drawn only during a run, the result is orange).
+        was_running = job_running()
         reply = yield from request(do="count", rect=vp, lo=[0, 180, 180], hi=[100, 255, 255], name="running")
-        if reply.get("count", 0) > 50 and job_running():
+        if reply.get("count", 0) > 50 and was_running:
             seen = True
             break
     check("the preview outline is drawn in the preference colour during the run", seen,
