@@ -470,7 +470,7 @@ def scenario_artist():
     real_progress = job_mod.SegmentJob._progress
 
     def slow_progress(self, *args):
-        time.sleep(0.01)
+        time.sleep(0.02)
         return real_progress(self, *args)
     job_mod.SegmentJob._progress = slow_progress
     started = yield from press_segment(button, wait=False)
@@ -481,9 +481,9 @@ def scenario_artist():
         if not job_running():
             break
         yield 0.3
-        # Running when the screenshot was asked for (the run may end while it is taken; the cyan
-        # preview is drawn only during a run, the result is orange).
-        was_running = job_running()
+        # The run (the modal operator) was on when the screenshot was asked for: the engine may
+        # finish while it is taken, and the cyan preview is drawn only until the run ends.
+        was_running = running()
         reply = yield from request(do="count", rect=vp, lo=[0, 180, 180], hi=[100, 255, 255], name="running")
         if reply.get("count", 0) > 50 and was_running:
             seen = True
