@@ -1,6 +1,18 @@
 #include "worker_pool.hpp"
 
 namespace relief_snake {
+namespace {
+// The worker index of the task this thread is running (-1 outside any task). A run() from inside
+// a task (nested parallelism, as libigl's parallel_for allows) then runs its items serially on
+// this thread under the same index, so per-worker scratch stays owned by one thread.
+thread_local int tls_worker = -1;
+
+struct InTask {
+  int saved;
+  explicit InTask(int worker) : saved(tls_worker) { tls_worker = worker; }
+  ~InTask() { tls_worker = saved; }
+};
+}  // namespace
 
 WorkerPool::WorkerPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -19,6 +31,7 @@ WorkerPool::~WorkerPool() {
 void WorkerPool::work(int worker) {
   for (int item = next_.fetch_add(1); item < count_; item = next_.fetch_add(1)) {
     try {
+      const InTask in_task(worker);
       (*task_)(item, worker);
     } catch (...) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -45,7 +58,12 @@ void WorkerPool::worker_main(int worker) {
 
 void WorkerPool::run(int count, const std::function<void(int, int)>& task) {
   if (count <= 0) return;
+  if (tls_worker >= 0) {  // nested: inside one of this (or another) pool's tasks
+    for (int item = 0; item < count; ++item) task(item, tls_worker);
+    return;
+  }
   if (threads_.empty() || count == 1) {
+    const InTask in_task(0);
     for (int item = 0; item < count; ++item) task(item, 0);
     return;
   }

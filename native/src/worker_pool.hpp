@@ -27,7 +27,8 @@ class WorkerPool {
   int size() const { return static_cast<int>(threads_.size()) + 1; }
   /// Calls task(item, worker) for every item in [0, count), spread over the
   /// workers, and returns when all are done. Rethrows the first exception.
-  /// Not re-entrant: call from one thread at a time.
+  /// Call from one thread at a time. A call from inside a task (nested) runs its items
+  /// serially on that thread, with that task's worker index.
   void run(int count, const std::function<void(int item, int worker)>& task);
 
  private:
