@@ -402,7 +402,6 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   }
 
   // --- the result ---------------------------------------------------------------
-  DerivedParameters& param = result.parameters;
   PhaseStats pre;
   pre.name = "preprocess";
   pre.seconds = preprocess_seconds;
@@ -414,17 +413,15 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   for (const std::string& n : best.notes) result.notes.push_back(n);
   if (options.w_int <= 0 && best.w_int != w_steps.front())
     result.notes.push_back("W_int " + fmt(best.w_int) + " chosen: the self-check failed with smaller values");
-  param = best.parameters;
+  result.parameters = best.parameters;
+  result.parameters.step_height = best.h;
   result.planarity_vertices = cache_->planarity ? cache_->planarity->raw_count() : 0;
-  param.step_height = best.h;
-  if (!h_given && std::fabs(std::log(best.h / h)) > 1e-12) {
-    // Refitted from the contour: as sure as the step found along it is even.
-    result.step_height_confidence =
+  if (!h_given) {
+    // As sure as the step found along the contour is even; a refitted h rests on that alone.
+    const double from_contour =
         std::clamp(1.0 - best.evidence.step.step_spread, 0.0, 1.0) * best.evidence.step.step_share;
-  } else if (!h_given) {
-    result.step_height_confidence =
-        std::max(result.step_height_confidence,
-                 std::clamp(1.0 - best.evidence.step.step_spread, 0.0, 1.0) * best.evidence.step.step_share);
+    const bool refitted = std::fabs(std::log(best.h / h)) > 1e-12;
+    result.step_height_confidence = refitted ? from_contour : std::max(result.step_height_confidence, from_contour);
   }
 
   result.contour = best.run.contour;

@@ -198,15 +198,11 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
 
   const Split split = otsu(heights, options.histogram_bins);
   std::vector<WeightedHeight> relief;
-  double total = 0, above = 0;
-  for (const auto& v : heights) {
-    total += v.weight;
-    if (v.height > split.threshold) relief.push_back(v), above += v.weight;
-  }
+  for (const auto& v : heights)
+    if (v.height > split.threshold) relief.push_back(v);
   const double value = weighted_quantile(relief, 0.5);
   if (!(value > 0) || !std::isfinite(value)) return estimate;
   estimate.value = value;
-  estimate.relief_share = total > 0 ? above / total : 0;
   // Sure when the heights split cleanly and the relief stands well above the fit's residual.
   const double clean = std::clamp((split.separation - options.min_separation) / (1 - options.min_separation), 0.0, 1.0);
   const double above_noise = std::clamp(value / (10 * background.residual + 1e-300) , 0.0, 1.0);

@@ -27,7 +27,6 @@ struct StepHeightEstimate {
   double value = 0;         ///< the estimated h (0: no relief found inside)
   double confidence = 0;    ///< 0..1: how clearly the heights split into background and relief
   double background_residual = 0;  ///< RMS residual of the background fit along the contour
-  double relief_share = 0;  ///< share of the enclosed area that rises above the threshold
   bool relief_left = true;  ///< open contours: the side that rises (closed: as given)
   double left_rise = 0, right_rise = 0;  ///< open contours: the 90% height on each side
 };
