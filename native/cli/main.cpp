@@ -3,6 +3,7 @@
 //   relief-snake segment MESH --picks I,J,K,... --step-height H [options]   -> JSON result
 //   relief-snake measure MESH I J                                          -> distance
 //   relief-snake info MESH                                                 -> mesh report
+//   relief-snake batch MANIFEST.json --out DIR [options]                    -> many scans (batch/)
 //
 // Exit codes: 0 success, 1 bad input or failed segmentation, 2 usage error.
 // Every error is exactly one line on stderr: "relief-snake: <message>".
@@ -23,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "batch_command.hpp"
 #include "extract_command.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/option_table.hpp"
@@ -41,6 +43,7 @@ const char* kUsage =
     "  relief-snake measure MESH I J\n"
     "  relief-snake info MESH\n"
     "  relief-snake extract MESH RESULT.json --out DIR [options]\n"
+    "  relief-snake batch MANIFEST.json --out DIR [options]\n"
     "  relief-snake --help\n"
     "\n"
     "MESH is an OBJ, PLY, STL or OFF file. Vertex indices (picks, I, J) are 0-based\n"
@@ -379,12 +382,15 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
-    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + advanced_options_help();
+    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + rs::cli::kBatchUsage + "\n" +
+                             advanced_options_help();
     const std::string command = args[0];
     if (command == "--help" || command == "-h" || command == "help") {
       std::cout << help;
       return 0;
     }
+    // batch: the runner parses its own arguments (--help included) and runs this executable per entry.
+    if (command == "batch") return rs::cli::run_batch(std::vector<std::string>(args.begin() + 1, args.end()));
     std::vector<std::string> rest;
     for (auto it = args.begin() + 1; it != args.end(); ++it) {
       if (*it == "--allow-partial") g_allow_partial = true;
