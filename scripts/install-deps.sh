@@ -23,3 +23,9 @@ if ! "$PYTHON" -c "import pytest, pybind11" >/dev/null 2>&1; then
   echo "install-deps: pip install pytest pybind11" >&2
   "$PYTHON" -m pip install -q pytest pybind11
 fi
+
+# relief-snake batch (docs/batch.md): Dask for --dask and tqdm for the progress bar (pyproject's "batch" extra).
+if ! "$PYTHON" -c "import dask.distributed, tqdm" >/dev/null 2>&1; then
+  echo "install-deps: pip install dask[distributed] tqdm" >&2
+  "$PYTHON" -m pip install -q "dask[distributed]>=2024.1" "tqdm>=4.60"
+fi
