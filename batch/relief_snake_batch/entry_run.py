@@ -185,7 +185,7 @@ def _run_cli(task: dict, entry_dir: Path, record: dict) -> None:
     partial = entry_dir / PARTIAL_RESULT
     record["exit_code"] = code
     if not exited:
-        record["status"] = "timeout"
+        record["status"], record["exit_code"] = "timeout", None
         record["message"] = (f"no result after {task['timeout']:g} s; killed (give the entry a longer "
                              f"\"timeout\" or the run a longer --timeout)")
     elif code < 0:

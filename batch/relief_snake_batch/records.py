@@ -7,7 +7,8 @@
     DIR/entries/ID/stderr.log    the CLI's stdout and stderr
     DIR/summary.json, summary.md the run's summary (summary.py)
 
-An entry is skipped on a rerun when its record is final (ok, doubtful, failed), its result file is
+An entry is skipped on a rerun when its record is final (ok, doubtful, failed on its input: exit code
+1 or an unreadable picks file, not 2, a command line the CLI refused), its result file is
 still there (ok, doubtful), and its fingerprint matches: the settings (the CLI flags, the picks, the
 region file's contents) and the mesh's contents (sha256; reused from the record while the file's size
 and mtime are unchanged, so an unchanged archive is not read again).
@@ -38,6 +39,8 @@ def reusable(out: Path, entry: Entry, record: dict | None, settings: str) -> boo
     """True when the entry's last record still stands for it (see the module's docstring)."""
     if not record or record.get("status") not in FINAL_STATUSES:
         return False
+    if record["status"] == "failed" and record.get("exit_code") == 2:
+        return False  # the CLI refused the command line itself (an older CLI without detect?): try again
     fingerprint = record.get("fingerprint") or {}
     if fingerprint.get("settings") != settings:
         return False

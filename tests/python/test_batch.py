@@ -228,6 +228,19 @@ def test_rerun_skips_finished_entries_and_reruns_changed_ones(cli, archive, loca
     assert {e["id"] for e in summary["entries"] if e["skipped"]} == set(before) - rerun
     assert summary["counts"]["failed"] == 3  # the skipped failures still count: exit code 1
 
+    # A command line the CLI refused (exit 2: here an advanced option it does not know) is tried again.
+    refused = archive["root"] / "manifest-refused.json"
+    refused.write_text(json.dumps({"entries": [{"id": "refused", "mesh": "scans/scan-01.ply",
+                                                "picks": "scans/scan-01.truth.json",
+                                                "options": {"no_such_option": 1}}]}))
+    refused_out = archive["root"] / "out-refused"
+    for attempt in range(2):
+        r = batch(cli, archive, refused_out, manifest=refused)
+        assert r.returncode == 1
+        rec = records(refused_out)["refused"]
+        assert rec["status"] == "failed" and rec["exit_code"] == 2 and "no_such_option" in rec["message"]
+        assert json.loads((refused_out / "summary.json").read_text())["ran"] == 1
+
     # A changed entry (its h), a changed mesh (same path, other contents) and a fixed one (the pick)
     # run again; a mesh only touched (same contents, new mtime) does not.
     names = archive["names"]
