@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import logging
 import re
+import tempfile
 import uuid
+import zipfile
 from concurrent import futures
 from pathlib import Path
 from typing import Callable
@@ -35,11 +37,13 @@ def make_task(entry: Entry, cli: Path, out: Path, timeout: float, settings: str,
 
 
 def lost_record(task: dict, error: BaseException) -> dict:
-    """The record of an entry whose worker was lost (Dask): not final, so a rerun tries it again."""
+    """The record of an entry Dask could not run (its worker died, the task could not be unpickled):
+    crashed, not final, so a rerun tries it again."""
     from .entry_run import RECORD_FORMAT, RECORD_NAME, write_json_atomic
+    first_line = (str(error).strip().splitlines() or [""])[0]
     record = {"format": RECORD_FORMAT, "id": task["id"], "index": task["index"], "kind": task["kind"],
               "status": "crashed", "exit_code": None, "signal": None, "result_status": None, "result": None,
-              "extract": None, "message": f"the Dask worker running it was lost ({type(error).__name__}: {error})",
+              "extract": None, "message": f"Dask could not run it ({type(error).__name__}: {first_line})",
               "started": None, "finished": utc_now(), "seconds": 0.0, "timeout": task["timeout"],
               "fingerprint": {"settings": task["settings"], "mesh": None}}
     try:
@@ -74,6 +78,19 @@ def run_local(tasks: list[dict], jobs: int, on_done: Callable[[dict], None]) -> 
             raise
 
 
+def _upload_runner(client) -> None:
+    """Sends this runner (relief_snake_batch as a zip) to the scheduler, which unpickles the tasks, and to
+    every worker, present and future (Client.upload_file), so the cluster needs no copy of it and runs
+    the same version as this client."""
+    package = Path(__file__).resolve().parent
+    with tempfile.TemporaryDirectory(prefix="relief-snake-batch-") as tmp:
+        archive = Path(tmp) / f"{package.name}.zip"
+        with zipfile.ZipFile(archive, "w") as z:
+            for source in sorted(package.glob("*.py")):
+                z.write(source, f"{package.name}/{source.name}")
+        client.upload_file(str(archive))
+
+
 def run_dask(tasks: list[dict], spec: str, on_done: Callable[[dict], None]) -> str:
     """Runs the tasks on Dask; returns a description of the cluster (for the summary)."""
     n_workers, address = parse_dask_spec(spec)
@@ -96,6 +113,8 @@ def run_dask(tasks: list[dict], spec: str, on_done: Callable[[dict], None]) -> s
             cluster.close()
         raise ExecutorError(f"cannot reach the Dask scheduler at {address or spec}: {e}") from None
     try:
+        if address is not None:
+            _upload_runner(client)
         workers = len(client.scheduler_info().get("workers", {}))
         description = f"dask {spec} ({workers} workers)"
         run_id = uuid.uuid4().hex[:8]

@@ -274,6 +274,11 @@ def _segment_flags(e: dict, manifest_dir: Path) -> tuple[list[str], str | None]:
     return flags, None
 
 
+def _id_from_mesh(mesh: str, index: int) -> str:
+    """An entry's default id: its mesh's file name without the extension, as a folder name."""
+    return re.sub(r"[^A-Za-z0-9._-]", "_", Path(mesh).stem).lstrip("._-") or f"entry-{index}"
+
+
 def parse_manifest(data: Any, manifest_dir: Path) -> list[Entry]:
     """The entries of a parsed manifest (json.load's value), paths resolved against manifest_dir."""
     if not isinstance(data, dict):
@@ -299,6 +304,8 @@ def parse_manifest(data: Any, manifest_dir: Path) -> list[Entry]:
             raise ManifestError(f"{where} must be an object with \"mesh\", got {json.dumps(raw)[:80]}")
         if isinstance(raw.get("id"), str):
             where = f"entry {index} ('{raw['id']}')"
+        elif isinstance(raw.get("mesh"), str) and raw["mesh"].strip():
+            where = f"entry {index} ('{_id_from_mesh(raw['mesh'], index)}')"
         _check_keys(raw, list(KEYS), where)
         if "mesh" not in raw:
             raise ManifestError(f"{where} has no \"mesh\"")
@@ -307,8 +314,7 @@ def parse_manifest(data: Any, manifest_dir: Path) -> list[Entry]:
         if "id" in raw:
             entry_id = raw["id"]
         else:
-            entry_id = re.sub(r"[^A-Za-z0-9._-]", "_", Path(raw["mesh"]).stem).lstrip("._-") or f"entry-{index}"
-            where = f"entry {index} ('{entry_id}')"
+            entry_id = _id_from_mesh(raw["mesh"], index)
         if entry_id in seen:
             raise ManifestError(f"{where}: entry {seen[entry_id]} has the same id '{entry_id}'"
                                 f"{'' if 'id' in raw else ' (from the mesh name)'}; give each entry its own \"id\"")

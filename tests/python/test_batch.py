@@ -276,7 +276,45 @@ def test_rerun_skips_finished_entries_and_reruns_changed_ones(cli, archive, loca
     assert json.loads((out / "summary.json").read_text())["skipped"] == 0
 
 
-def test_dask_local_cluster_runs_the_same_manifest(cli, archive, local_run):
+@pytest.fixture(scope="module")
+def dask_scheduler(tmp_path_factory):
+    """A real `dask scheduler` and one `dask worker` (2 processes), started without relief_snake_batch on
+    their path and from another folder; stopped (their process groups) afterwards."""
+    try:
+        import dask.distributed  # noqa: F401
+    except ImportError:
+        pytest.fail("dask.distributed is not installed: scripts/install-deps.sh installs it")
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    tmp_path = tmp_path_factory.mktemp("dask")
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    python = sys.executable
+    started = []
+    try:
+        for cmd in ([python, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                     "--no-dashboard"],
+                    [python, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1", "--nworkers", "2",
+                     "--no-dashboard"]):
+            started.append(subprocess.Popen(cmd, cwd=tmp_path, env=env, stdout=subprocess.DEVNULL,
+                                            stderr=open(tmp_path / f"dask-{len(started)}.log", "w"),
+                                            start_new_session=True))
+        from dask.distributed import Client
+        with Client(address, timeout="60s") as client:
+            client.wait_for_workers(2, timeout=120)
+        yield address
+    finally:
+        for p in started:
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            p.wait()
+
+
+def test_dask_local_cluster_runs_the_same_manifest(cli, archive, local_run, dask_scheduler):
     try:
         import dask.distributed  # noqa: F401
     except ImportError:
@@ -298,13 +336,31 @@ def test_dask_local_cluster_runs_the_same_manifest(cli, archive, local_run):
     # Same outcome per entry as the local pool (one engine thread per scan: deterministic).
     assert {i: rec["status"] for i, rec in recs.items()} == local_run["statuses"]
 
-    # A rerun on Dask skips what finished.
-    r = batch(cli, archive, out, "--dask", "local:2")
+    # A rerun on Dask skips what finished (on the running scheduler below: the records, not the cluster,
+    # say what finished).
+    r = batch(cli, archive, out, "--dask", dask_scheduler)
     assert r.returncode == 1, r.stderr[-2000:]
     again = json.loads((out / "summary.json").read_text())
     assert again["ran"] == 2 and again["skipped"] == N_SCANS + 3
     after = records(out)
     assert {i for i in after if after[i]["started"] != recs[i]["started"]} == {"segfault", "hang"}
+
+
+def test_dask_scheduler_address_runs_the_entries_on_its_workers(cli, archive, dask_scheduler, tmp_path):
+    names = archive["names"]
+    path = write_manifest(archive["root"], {"entries": [
+        *[{"mesh": f"scans/{n}.ply", "picks": f"scans/{n}.truth.json"} for n in names[:4]],
+        {"id": "segfault", "mesh": "scans/segfault.ply", "picks": "scans/scan-01.truth.json"}]}, "m-tcp.json")
+    out = tmp_path / "out"
+    p = subprocess.Popen([str(cli), "batch", str(path), "--out", str(out), "--cli", str(archive["fake"]), "--dask",
+                          dask_scheduler], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _, stderr = p.communicate(timeout=300)
+    assert p.returncode == 1, stderr[-2000:]
+    recs = records(out)
+    assert {i: rec["status"] for i, rec in recs.items()} == {**{n: "ok" for n in names[:4]}, "segfault": "crashed"}
+    pids = {rec["pid"] for rec in recs.values()}
+    assert 1 <= len(pids) <= 2 and p.pid not in pids  # the worker processes ran them, not the runner
+    assert json.loads((out / "summary.json").read_text())["executor"] == f"dask {dask_scheduler} (2 workers)"
 
 
 def test_interrupt_kills_running_entries_and_keeps_finished_ones(cli, archive):
@@ -515,7 +571,7 @@ def test_the_example_manifest_is_valid():
     entries = manifest_mod.load_manifest(REPO_ROOT / "examples" / "batch" / "manifest.json")
     assert [(e.id, e.kind) for e in entries] == [("duck", "segment"), ("disk-h1", "segment"),
                                                  ("panel", "segment"), ("plate-detect", "detect")]
-    # Its scans are made by make-scans.sh: until then each segment entry is its own input failure.
-    assert all("make-scans" not in (e.input_error or "") for e in entries)
-    assert entries[0].input_error and "duck.truth.json" in entries[0].input_error
     assert entries[3].flags == ["--min-area", "25"]
+    # Its picks files come with the scans (make-scans.sh): either read, or that entry's own input failure.
+    for e in entries[:3]:
+        assert (bool(e.flags) and e.flags[0] == "--picks") != bool(e.input_error), e
