@@ -108,10 +108,12 @@ def run_dask(tasks: list[dict], spec: str, on_done: Callable[[dict], None]) -> s
             client = Client(cluster)
         else:
             client = Client(address, timeout="30s")
-    except (OSError, TimeoutError) as e:
+    except Exception as e:  # OSError, TimeoutError, or a LocalCluster whose workers did not start
         if cluster is not None:
             cluster.close()
-        raise ExecutorError(f"cannot reach the Dask scheduler at {address or spec}: {e}") from None
+        what = f"cannot reach the Dask scheduler at {address}" if address else f"cannot start a Dask {spec} cluster"
+        first_line = (str(e).strip().splitlines() or [type(e).__name__])[0]
+        raise ExecutorError(f"{what}: {first_line}") from None
     try:
         if address is not None:
             _upload_runner(client)
