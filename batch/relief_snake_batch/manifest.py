@@ -179,6 +179,12 @@ def _check_path(v, where):
     return v
 
 
+def _check_degree(v, where):
+    if isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 6:
+        return v
+    raise ManifestError(f"{where} must be a whole number from 0 to 6, got {json.dumps(v)}")
+
+
 def _check_positive(v, where):
     if _is_number(v) and v > 0:
         return v
@@ -191,15 +197,17 @@ KEYS: dict[str, tuple[str, Callable]] = {
     "id": ("entry", _check_id),
     "detect": ("any", _check_bool),
     "picks": ("segment", _check_picks),
-    "h": ("segment", _check_h),
+    "h": ("any", _check_h),
     "w_int": ("segment", _check_w_int),
     "closed": ("segment", _check_bool),
     "relief_side": ("segment", _check_relief_side),
     "max_iterations": ("segment", _check_max_iterations),
-    "options": ("segment", _check_options),
+    "options": ("any", _check_options),
     "extract": ("segment", _check_extract),
     "region_vertices": ("detect", _check_path),
     "min_area": ("detect", _check_positive),
+    "background_degree": ("detect", _check_degree),
+    "refine": ("detect", _check_bool),
     "allow_partial": ("any", _check_bool),
     "timeout": ("any", _check_positive),
 }
@@ -238,6 +246,29 @@ def read_picks_file(path: Path) -> list[int]:
     return [int(t) for t in items]
 
 
+def _option_flags(e: dict) -> list[str]:
+    flags = []
+    for name, value in sorted(e.get("options", {}).items()):
+        text = ("1" if value else "0") if isinstance(value, bool) else (
+            value if isinstance(value, str) else _number_text(value))
+        flags += ["--option", f"{name}={text}"]
+    return flags
+
+
+def _detect_flags(e: dict) -> list[str]:
+    """CLI flags of a detect entry (relief-snake detect's own; --region-vertices is added at run time)."""
+    flags = []
+    if "min_area" in e:
+        flags += ["--min-area", _number_text(e["min_area"])]
+    if isinstance(e.get("h"), (int, float)):  # "auto": detect's default, each candidate's own height
+        flags += ["--step-height", _number_text(e["h"])]
+    if "background_degree" in e:
+        flags += ["--background-degree", str(e["background_degree"])]
+    if e.get("refine", True) is False:
+        flags.append("--no-refine")
+    return flags + _option_flags(e)
+
+
 def _segment_flags(e: dict, manifest_dir: Path) -> tuple[list[str], str | None]:
     """CLI flags of a segment entry, and an input error (picks file) or None."""
     picks = e.get("picks")
@@ -259,10 +290,7 @@ def _segment_flags(e: dict, manifest_dir: Path) -> tuple[list[str], str | None]:
         flags += ["--relief-side", e["relief_side"]]
     if "max_iterations" in e:
         flags += ["--max-iterations", str(e["max_iterations"])]
-    for name, value in sorted(e.get("options", {}).items()):
-        text = ("1" if value else "0") if isinstance(value, bool) else (
-            value if isinstance(value, str) else _number_text(value))
-        flags += ["--option", f"{name}={text}"]
+    flags += _option_flags(e)
     extract = e.get("extract", False)
     if extract:
         flags += ["--extract", "extract"]
@@ -342,8 +370,7 @@ def parse_manifest(data: Any, manifest_dir: Path) -> list[Entry]:
             if entry.input_error and "picks" not in merged:
                 raise ManifestError(f"{where} {entry.input_error}")
         else:
-            if "min_area" in merged:
-                entry.flags += ["--min-area", _number_text(merged["min_area"])]
+            entry.flags = _detect_flags(merged)
             if "region_vertices" in merged:
                 entry.region_vertices = (manifest_dir / merged["region_vertices"]).resolve()
         if merged.get("allow_partial", False):

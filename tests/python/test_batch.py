@@ -414,6 +414,8 @@ def write_manifest(tmp_path, data, name="m.json"):
                                                                              "detect"]),
     ({"entries": [{"mesh": "a.ply", "picks": [1, 2, 3], "min_area": 3}]}, ["\"min_area\" does not apply",
                                                                              "segment"]),
+    ({"entries": [{"mesh": "a.ply", "detect": True, "background_degree": 7}]}, ["background_degree", "0 to 6"]),
+    ({"entries": [{"mesh": "a.ply", "detect": True, "closed": False}]}, ["\"closed\" does not apply"]),
     ({"entries": [{"mesh": "x/a.ply", "picks": [1, 2, 3]}, {"mesh": "y/a.ply", "picks": [1, 2, 3]}]},
      ["entry 2 ('a')", "entry 1", "same id", "\"id\""]),
     ({"entries": [{"mesh": "a.ply", "id": "../up", "picks": [1, 2, 3]}]}, ["\"id\"", "letters"]),
@@ -514,7 +516,8 @@ def test_entries_map_onto_cli_flags(tmp_path):
             {"mesh": "c.ply", "id": "open-c", "picks": "truth.json", "closed": False, "relief_side": "left",
              "extract": {"pixel_size": 0.2, "flatten": "plane"}},
             {"mesh": "d.ply", "picks": "list.json", "extract": True, "timeout": 5},
-            {"mesh": "e.ply", "detect": True, "region_vertices": "region.txt"},
+            {"mesh": "e.ply", "detect": True, "region_vertices": "region.txt", "background_degree": 2,
+             "refine": False},
             {"mesh": "f.ply", "picks": "nothere.txt"},
         ]}, tmp_path)
     a, b, c, d, e, f = entries
@@ -527,12 +530,13 @@ def test_entries_map_onto_cli_flags(tmp_path):
     assert c.flags[4:] == ["--open", "--relief-side", "left", "--option", "remove_loops=1", "--option", "tau=0.25",
                            "--extract", "extract", "--pixel-size", "0.2", "--flatten", "plane"]
     assert d.flags[:2] == ["--picks", "11,12,13"] and d.flags[-2:] == ["--extract", "extract"] and d.timeout == 5
-    # A detect entry: the defaults' segment keys do not apply to it, its own detect keys do.
-    assert e.kind == "detect" and e.flags == ["--min-area", "9"]
+    # A detect entry: the defaults' segment-only keys do not apply to it; h, options and its own keys do.
+    assert e.kind == "detect" and e.flags == ["--min-area", "9", "--step-height", "0.5", "--background-degree", "2",
+                                              "--no-refine", "--option", "remove_loops=1", "--option", "tau=0.25"]
     assert e.region_vertices == (tmp_path / "region.txt").resolve()
     task = {"cli": "/bin/relief-snake", "kind": e.kind, "mesh": str(e.mesh), "flags": e.flags,
             "region_vertices": str(e.region_vertices)}
-    assert entry_run.command_of(task) == ["/bin/relief-snake", "detect", str(e.mesh), "--min-area", "9",
+    assert entry_run.command_of(task) == ["/bin/relief-snake", "detect", str(e.mesh), *e.flags,
                                           "--region-vertices", str(e.region_vertices), "--out",
                                           entry_run.PARTIAL_RESULT]
     # A missing picks file is that entry's failure, not the manifest's.
@@ -571,7 +575,7 @@ def test_the_example_manifest_is_valid():
     entries = manifest_mod.load_manifest(REPO_ROOT / "examples" / "batch" / "manifest.json")
     assert [(e.id, e.kind) for e in entries] == [("duck", "segment"), ("disk-h1", "segment"),
                                                  ("panel", "segment"), ("plate-detect", "detect")]
-    assert entries[3].flags == ["--min-area", "25"]
+    assert entries[3].flags == ["--min-area", "25", "--option", "threads=1"]
     # Its picks files come with the scans (make-scans.sh): either read, or that entry's own input failure.
     for e in entries[:3]:
         assert (bool(e.flags) and e.flags[0] == "--picks") != bool(e.input_error), e
