@@ -6,13 +6,15 @@ The CLI runs in its own session (process group), from the entry's folder DIR/ent
 stdout and stderr in stderr.log there. It writes its result to a temporary name that is renamed to
 result.json only when the CLI exited with a result (0 or 3), so result.json is never half-written.
 A timeout, or any child the CLI left behind, is ended by killing the whole group; the group id stays
-reserved until the CLI is reaped (os.waitid with WNOWAIT), so the kill cannot reach a stranger.
+reserved until the CLI is reaped (it is waited for with a pidfd or os.waitid(WNOWAIT), neither of
+which reaps it), so the kill cannot reach a stranger.
 """
 from __future__ import annotations
 
 import datetime
 import json
 import os
+import select
 import shutil
 import signal
 import socket
@@ -86,7 +88,19 @@ def _kill_group(group: int) -> None:
 
 
 def _wait_for_exit(pid: int, timeout: float) -> bool:
-    """Waits until the process exits, without reaping it. False when the timeout passed first."""
+    """Waits until the process exits, without reaping it. False when the timeout passed first.
+    A pidfd (Linux 5.3+) wakes us the moment it exits; elsewhere waitid(WNOWAIT) is polled."""
+    try:
+        fd = os.pidfd_open(pid)
+    except (AttributeError, OSError):
+        fd = None
+    if fd is not None:
+        try:
+            poller = select.poll()  # not select.select: a worker may hold more than FD_SETSIZE files
+            poller.register(fd, select.POLLIN)
+            return bool(poller.poll(max(0.0, timeout) * 1000))
+        finally:
+            os.close(fd)
     deadline = time.monotonic() + timeout
     pause = 0.005
     while True:
