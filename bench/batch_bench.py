@@ -62,7 +62,7 @@ def main(argv=None) -> int:
                 return 1
             s = json.loads((out / "summary.json").read_text())
             print(f"{name:<28} {seconds:>10.2f} {s['wall_seconds']:>9.2f} {s['entry_seconds_ran']:>13.2f} "
-                  f"{s['ran']:>5} {s['counts']['ok']:>5}")
+                  f"{s['ran']:>5} {s['counts']['ok']:>5}  {s['executor']}")
     return 0
 
 

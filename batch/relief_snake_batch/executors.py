@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import re
 import tempfile
+import time
 import uuid
 import zipfile
 from concurrent import futures
@@ -100,6 +101,7 @@ def run_dask(tasks: list[dict], spec: str, on_done: Callable[[dict], None]) -> s
         raise ExecutorError("--dask needs dask.distributed: python3 -m pip install \"dask[distributed]\" "
                             "(scripts/install-deps.sh installs it)") from None
     cluster = None
+    start = time.monotonic()
     try:
         if n_workers is not None:
             # One thread per worker: each runs one CLI at a time, like --jobs N.
@@ -118,7 +120,7 @@ def run_dask(tasks: list[dict], spec: str, on_done: Callable[[dict], None]) -> s
         if address is not None:
             _upload_runner(client)
         workers = len(client.scheduler_info().get("workers", {}))
-        description = f"dask {spec} ({workers} workers)"
+        description = f"dask {spec} ({workers} workers, up in {time.monotonic() - start:.1f} s)"
         run_id = uuid.uuid4().hex[:8]
         by_key = {}
         submitted = []
