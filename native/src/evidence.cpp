@@ -64,6 +64,19 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   const double exclude = std::max(options.outside_from * h, edge);
   const double exclude2 = exclude * exclude;
 
+  const double front_from = std::max(options.front_from * h, options.front_from_edges * edge);
+  const double front_to = std::max(options.front_to * h, options.front_to_edges * edge);
+  const double front_half_width = std::max(options.front_half_width * h, options.front_half_width_edges * edge);
+  const auto point_at = [&](int j) {
+    j = options.closed ? (j % n + n) % n : std::clamp(j, 0, n - 1);
+    return position(mesh, contour[j]);
+  };
+
+  const double strip_half_width = std::max(0.5 * h, 1.5 * edge);
+  // Per measured profile: (distance inwards, height) of the inside vertices in a strip across
+  // the contour, for the offset to the step once the step height is known.
+  std::vector<std::vector<std::pair<double, double>>> strips;
+
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
   std::vector<double> heights;
   std::vector<int> outside, near_outside;
@@ -121,6 +134,36 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     for (const int v : near_outside) heights.push_back((mesh.position(v) - mean).dot(normal));
     profile.foot = quantile(heights, 0.5);
     profile.at_foot = heights.empty() || profile.foot < options.max_foot * profile.rise;
+
+    // The front: inside vertices in a box right behind the point, across the contour's
+    // tangent in the background plane, on the side where the inside lies.
+    Vec3 tangent = point_at(i + 1) - point_at(i - 1);
+    tangent -= tangent.dot(normal) * normal;
+    Vec3 inside_mean = Vec3::Zero();
+    for (const int v : ball)
+      if (region[v]) inside_mean += mesh.position(v) - centre;
+    if (tangent.squaredNorm() > 0) {
+      tangent.normalize();
+      Vec3 inward = normal.cross(tangent);
+      if (inward.dot(inside_mean) < 0) inward = -inward;
+      heights.clear();
+      strips.emplace_back();
+      for (const int v : ball) {
+        if (!region[v]) continue;
+        const Vec3 d = mesh.position(v) - centre;
+        const double across = d.dot(inward), along = d.dot(tangent);
+        const double height = (mesh.position(v) - mean).dot(normal);
+        if (across >= front_from && across <= front_to && std::fabs(along) <= front_half_width)
+          heights.push_back(height);
+        if (std::fabs(along) <= strip_half_width) strips.back().push_back({across, height});
+      }
+      if (heights.size() >= 2) {
+        profile.front_measured = true;
+        profile.front = quantile(heights, 0.5);
+      }
+    } else {
+      strips.emplace_back();
+    }
     evidence.profiles.push_back(profile);
   }
 
@@ -140,6 +183,55 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     evidence.step_height = quantile(step_rises, 0.5);
     if (evidence.step_height > 0)
       evidence.step_spread = (quantile(step_rises, 0.75) - quantile(step_rises, 0.25)) / evidence.step_height;
+  }
+  // Runs of consecutive profiles (in contour order) whose front is low against the step
+  // found along the whole contour, as contour length.
+  {
+    int low = 0;
+    const double front_floor = std::max(options.min_rise * h, options.front_low * evidence.step_height);
+    for (StepProfile& p : evidence.profiles) {
+      p.front_low = p.front_measured && p.front < front_floor;
+      low += p.front_low ? 1 : 0;
+    }
+    evidence.front_low_share = double(low) / evidence.profiles.size();
+    double length = 0;
+    for (int j = 0; j + 1 < n || (options.closed && j < n); ++j) length += (point_at(j + 1) - point_at(j)).norm();
+    const double spacing = length / count;  // contour length per attempted profile
+    const int m = static_cast<int>(evidence.profiles.size());
+    int run = 0, longest = 0;
+    // A closed contour's run may wrap: go round twice, runs capped at m.
+    for (int k = 0; k < (options.closed ? 2 * m : m); ++k) {
+      const StepProfile& p = evidence.profiles[k % m];
+      run = p.front_low ? std::min(run + 1, m) : 0;
+      longest = std::max(longest, run);
+    }
+    evidence.longest_front_low = longest * spacing;
+
+    // Offset from each point inwards to where the surface first reaches half the step.
+    std::vector<double> offsets;
+    for (std::size_t k = 0; k < evidence.profiles.size(); ++k) {
+      double offset = radius;
+      for (const auto& [across, height] : strips[k])
+        if (height >= 0.5 * evidence.step_height) offset = std::min(offset, std::max(0.0, across));
+      evidence.profiles[k].offset = offset;
+      offsets.push_back(offset);
+    }
+    evidence.offset_median = quantile(offsets, 0.5);
+    const double far = evidence.offset_median + std::max(options.offset_tolerance * h, 2 * edge);
+    int far_count = 0, longest_end = -1;
+    run = longest = 0;
+    for (int k = 0; k < (options.closed ? 2 * m : m); ++k) {
+      const bool is_far = evidence.profiles[k % m].offset > far;
+      if (k < m) far_count += is_far ? 1 : 0;
+      run = is_far ? std::min(run + 1, m) : 0;
+      if (run > longest) longest = run, longest_end = k;
+    }
+    if (longest > 0) evidence.far_point = evidence.profiles[(longest_end - longest / 2) % m].contour_index;
+    evidence.offset_q90 = quantile(offsets, 0.9);
+    evidence.offset_q75 = quantile(offsets, 0.75);
+    evidence.offset_q95 = quantile(offsets, 0.95);
+    evidence.far_share = double(far_count) / m;
+    evidence.longest_far = longest * spacing;
   }
   return evidence;
 }
@@ -172,7 +264,7 @@ Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region) {
   return area;
 }
 
-SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options) {
+SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options, const Vec3* far_position) {
   SelfCheck check;
   const StepEvidence& evidence = all.step;
   const double measured = evidence.measured_share();
@@ -183,6 +275,15 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("only " + percent(evidence.step_share) +
                             " of the contour runs along a step: it may have crossed into the relief or stopped "
                             "on detail or texture");
+  if (evidence.longest_far > options.max_far_run * h) {
+    std::string where;
+    if (far_position)
+      where = " around (" + number((*far_position)[0]) + ", " + number((*far_position)[1]) + ", " +
+              number((*far_position)[2]) + ")";
+    check.reasons.push_back("a stretch of the contour " + number(evidence.longest_far / h) + " h long" + where +
+                            " runs away from the step: the region takes in background there (a lobe out into "
+                            "the background, or a bridge across a concavity)");
+  }
   if (evidence.step_share >= options.min_step_share && evidence.foot_share < options.min_foot_share)
     check.reasons.push_back("only " + percent(evidence.foot_share) +
                             " of the contour sits at the foot of the step; the rest runs partway up it");
@@ -208,7 +309,7 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
   // Prefer evidence that holds; then more of the contour on a step, a region that agrees
   // with the coarse phase, and a step that agrees with h.
   const double ratio = evidence.step_height > 0 ? std::fabs(std::log(evidence.step_height / h)) : 2.0;
-  check.score = (check.holds ? 10.0 : 0.0) + 2.0 * evidence.step_share * std::min(1.0, measured / 0.6) +
+  check.score = (check.holds ? 10.0 : 0.0) - 2.0 * evidence.far_share + 2.0 * evidence.step_share * std::min(1.0, measured / 0.6) +
                 std::min(coarse_iou, 0.8) - 0.5 * std::min(ratio, 2.0);
   return check;
 }

@@ -263,6 +263,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   // its h is on something else (texture, detail).
   SelfCheckOptions self_check;
   if (options.refit_step_height) self_check.max_step_ratio = std::max(1.5, options.refit_ratio * 1.15);
+  EvidenceOptions evidence_options;
+  evidence_options.closed = options.closed;
 
   // --- attempts: schedule -> foot -> region -> self-check, for each h and W_int tried
   const std::vector<double> w_steps =
@@ -299,7 +301,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       return best;
     }
     const std::vector<char> coarse_region = relief_region(mesh, coarse.contour, options.closed, inside_left);
-    const double coarse_step_share = measure_step(mesh, coarse.contour, coarse_region, h_try).step_share;
+    const double coarse_step_share = measure_step(mesh, coarse.contour, coarse_region, h_try, evidence_options).step_share;
     bool first = true;
     for (const double w : w_steps) {
       Attempt a;
@@ -337,7 +339,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.run.contour = snake.points();
       }
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
-      a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try);
+      a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       a.evidence.coarse_step_share = coarse_step_share;
       a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
       if (options.closed) {
@@ -356,9 +358,11 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                       : 0.0;
       } else if (!side_given) {
         const std::vector<char> other = relief_region(mesh, a.run.contour, false, !inside_left);
-        a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try).step_share;
+        a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try, evidence_options).step_share;
       }
-      a.check = judge(a.evidence, h_try, self_check);
+      const int far_index = a.evidence.step.far_point;
+      const Vec3 far_position = far_index >= 0 ? position(mesh, a.run.contour[far_index]) : Vec3::Zero();
+      a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       const bool holds = a.check.holds;
       if (first || better(a, best)) best = std::move(a);
       first = false;
@@ -443,7 +447,15 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"coarse_step_share", best.evidence.coarse_step_share},
                    {"coarse_iou", best.evidence.coarse_iou},
                    {"area_ratio", best.evidence.area_ratio},
-                   {"region_area", region_area(mesh, best.region)}};
+                   {"region_area", region_area(mesh, best.region)},
+                   {"front_low_share", step.front_low_share},
+                   {"front_low_run", step.longest_front_low / best.h},
+                   {"offset_median", step.offset_median / best.h},
+                   {"offset_q75", step.offset_q75 / best.h},
+                   {"offset_q90", step.offset_q90 / best.h},
+                   {"offset_q95", step.offset_q95 / best.h},
+                   {"far_share", step.far_share},
+                   {"far_run", step.longest_far / best.h}};
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (best.run.hit_cap) {

@@ -29,14 +29,18 @@ syn::Scan disk_scan(syn::Background background, syn::Step step, double h = 1.0, 
 }
 
 // A closed contour on the level set sd = offset of the scan's silhouette (negative: inside
-// the relief), as snaxels at the nearest mesh vertices, counter-clockwise.
-std::vector<SurfacePoint> level_set_contour(const syn::Scan& scan, const Mesh& mesh, double radius_offset) {
+// the relief), as snaxels at the nearest mesh vertices, counter-clockwise; optionally with
+// a lobe of height `lobe` (parameter units) and half-width `lobe_half_width` (radians)
+// out into the background around angle 0.
+std::vector<SurfacePoint> level_set_contour(const syn::Scan& scan, const Mesh& mesh, double radius_offset,
+                                            double lobe = 0, double lobe_half_width = 0.3) {
   // The disk has radius 12 centred at the origin of the parameter plane.
   std::vector<SurfacePoint> out;
   const int n = 200;
   int last = -1;
   for (int k = 0; k < n; ++k) {
-    const double a = 2 * M_PI * k / n, r = 12 + radius_offset;
+    const double a = 2 * M_PI * k / n, from_lobe = std::min(a, 2 * M_PI - a);
+    const double r = 12 + radius_offset + lobe * std::max(0.0, 1 - from_lobe / lobe_half_width);
     const int v = scan.nearest_vertex(r * std::cos(a), r * std::sin(a));
     if (v != last) out.push_back(vertex_point(mesh, v));
     last = v;
@@ -44,11 +48,36 @@ std::vector<SurfacePoint> level_set_contour(const syn::Scan& scan, const Mesh& m
   return out;
 }
 
-StepEvidence evidence_at(const syn::Scan& scan, const Mesh& mesh, double offset, double h) {
-  const std::vector<SurfacePoint> contour = level_set_contour(scan, mesh, offset);
+StepEvidence evidence_at(const syn::Scan& scan, const Mesh& mesh, double offset, double h, double lobe = 0) {
+  const std::vector<SurfacePoint> contour = level_set_contour(scan, mesh, offset, lobe);
   const bool left = contour_orientation_left(mesh, contour);
   const std::vector<char> region = relief_region(mesh, contour, true, left);
   return measure_step(mesh, contour, region, h);
+}
+
+// The disk's contour with a lobe out into the background, and the region it encloses
+// (taken from the parameter plane: snapping a lobe to vertices can make it touch itself).
+StepEvidence lobe_evidence(const syn::Scan& scan, const Mesh& mesh, double lobe) {
+  const double half_width = 0.3;
+  const auto radius_at = [&](double a) {
+    a = std::fmod(a + 2 * M_PI, 2 * M_PI);
+    return 12 + lobe * std::max(0.0, 1 - std::min(a, 2 * M_PI - a) / half_width);
+  };
+  std::vector<SurfacePoint> contour;
+  int last = -1;
+  for (int k = 0; k < 400; ++k) {
+    const double a = 2 * M_PI * k / 400;
+    const int v = scan.nearest_vertex(radius_at(a) * std::cos(a), radius_at(a) * std::sin(a));
+    if (v != last) contour.push_back(vertex_point(mesh, v));
+    last = v;
+  }
+  std::vector<char> region(mesh.n_vertices(), 0);
+  for (std::size_t i = 0; i < scan.n_vertices(); ++i) {
+    const double u = scan.UV[2 * i], w = scan.UV[2 * i + 1];
+    const int v = mesh.input_to_mesh(i);
+    if (v >= 0) region[v] = std::hypot(u, w) < radius_at(std::atan2(w, u)) ? 1 : 0;
+  }
+  return measure_step(mesh, contour, region, scan.h);
 }
 
 }  // namespace
@@ -72,6 +101,29 @@ TEST(Evidence, AContourInsideTheReliefOrOnTheBackgroundShowsNoStep) {
   const Mesh mesh = syn::to_mesh(scan);
   EXPECT_LT(evidence_at(scan, mesh, -5.0, scan.h).step_share, 0.2);  // collapsed onto the relief's top
   EXPECT_LT(evidence_at(scan, mesh, 6.0, scan.h).step_share, 0.2);   // still out on the background
+}
+
+TEST(Evidence, ALobeOutIntoTheBackgroundRunsAwayFromTheStep) {
+  for (const auto step : {syn::Step::Sharp, syn::Step::Blended}) {
+    SCOPED_TRACE(step == syn::Step::Sharp ? "sharp" : "blended");
+    const syn::Scan scan = disk_scan(syn::Background::Sphere, step);
+    const Mesh mesh = syn::to_mesh(scan);
+    const StepEvidence on = evidence_at(scan, mesh, 0.0, scan.h);
+    EXPECT_LT(on.longest_far, SelfCheckOptions{}.max_far_run * scan.h);  // the true contour passes
+    // A lobe 3 h out and about 7 h wide: most of the contour is still on the step, but the
+    // stretch round the lobe is not, and it is found.
+    const StepEvidence lobe = lobe_evidence(scan, mesh, 3.0 * scan.h);
+    EXPECT_GT(lobe.step_share, 0.85);
+    EXPECT_GT(lobe.longest_far, 2.0 * scan.h);
+    EXPECT_GE(lobe.far_point, 0);
+    ContourEvidence e;
+    e.step = lobe;
+    const SelfCheck c = judge(e, scan.h);
+    ASSERT_FALSE(c.holds);
+    bool named = false;
+    for (const std::string& r : c.reasons) named = named || r.find("runs away from the step") != std::string::npos;
+    EXPECT_TRUE(named);
+  }
 }
 
 TEST(Evidence, JudgeNamesEachFailedCheck) {
@@ -98,6 +150,11 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   e.area_ratio = 1.0;
   EXPECT_FALSE(judge(e, 3.0).holds);  // the step found is a third of h
   EXPECT_GT(judge(e, 1.0).score, judge(e, 3.0).score);
+  e.step.longest_far = 1.5;  // 1.5 h of contour away from the step
+  const Vec3 where(1, 2, 3);
+  c = judge(e, 1.0, {}, &where);
+  ASSERT_EQ(c.reasons.size(), 1u);
+  EXPECT_NE(c.reasons.front().find("(1, 2, 3)"), std::string::npos);
 }
 
 TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {

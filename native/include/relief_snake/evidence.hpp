@@ -32,6 +32,15 @@ struct EvidenceOptions {
   double max_foot = 0.35;       ///< at the foot: the surface just outside rises less than this share of the rise
   int max_profiles = 240;       ///< contour points measured (evenly spread)
   int min_side_vertices = 6;    ///< fewer inside or outside vertices in the ball: not measured
+  /// The front: the inside just behind the point, in a box inwards across the contour, from
+  /// front_from to front_to and front_half_width to each side (in h, and at least the
+  /// *_edges values in average edges). A contour bridging a concavity has the relief on both
+  /// sides of the ball but background right behind it.
+  double front_from = 0.5, front_to = 1.5, front_half_width = 0.75;
+  double front_from_edges = 1, front_to_edges = 2.5, front_half_width_edges = 1.5;
+  double offset_tolerance = 0.5; ///< a point is far from the step if its offset exceeds the median by this (in h, >= 2 edges)
+  double front_low = 0.5;       ///< a front below this share of the step found (and below min_rise h) is low
+  bool closed = true;           ///< the contour is closed: its runs wrap around
 };
 
 /// One measured contour point.
@@ -42,6 +51,10 @@ struct StepProfile {
   double foot = 0;      ///< median height above the plane of the outside vertices right at the point
   bool on_step = false;
   bool at_foot = true;  ///< the surface just outside is background: the contour is not up the step
+  double front = 0;     ///< median height above the plane of the inside right behind the point
+  bool front_measured = false;  ///< enough inside vertices behind the point
+  bool front_low = false;       ///< measured, and the inside right behind is well below the step found
+  double offset = 0;            ///< distance inwards to the first inside vertex at half the step found (ball radius: none)
 };
 
 struct StepEvidence {
@@ -53,6 +66,12 @@ struct StepEvidence {
   double rise_median = 0;             ///< median rise of all measured profiles
   double step_spread = 0;             ///< (q75 - q25) / median of the on-step rises: how even the step is
   double background_residual = 0;     ///< median RMS residual of the outside fits
+  double front_low_share = 0;         ///< share of the measured profiles whose front is at background height
+  double longest_front_low = 0;       ///< longest run of consecutive such profiles, as contour length
+  double offset_median = 0, offset_q75 = 0, offset_q90 = 0, offset_q95 = 0;  ///< of the profiles' offsets to half the step
+  double far_share = 0;               ///< share of profiles whose offset exceeds the median by the tolerance
+  double longest_far = 0;             ///< longest run of such profiles, as contour length
+  int far_point = -1;                 ///< contour index in the middle of that run (-1: none)
   double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
 };
 
@@ -74,6 +93,9 @@ struct SelfCheckOptions {
   /// (the vector area of any surface a curve bounds is the same, walls and curvature included);
   /// outside [1 / max_area_ratio, max_area_ratio] the region leaked or lost a piece.
   double max_area_ratio = 1.25;
+  /// Longest stretch of contour (in h) allowed to run away from the step (StepEvidence::longest_far):
+  /// a lobe out into the background, or a bridge across a concavity.
+  double max_far_run = 1.0;
 };
 
 /// Everything the self-check looks at for one contour.
@@ -92,8 +114,10 @@ struct SelfCheck {
   std::vector<std::string> reasons;  ///< one plain sentence per failed check
 };
 
-/// Judges a contour's evidence; h: the step height used.
-SelfCheck judge(const ContourEvidence& evidence, double h, const SelfCheckOptions& options = {});
+/// Judges a contour's evidence; h: the step height used. far_position: where the longest
+/// stretch away from the step is (named in its reason).
+SelfCheck judge(const ContourEvidence& evidence, double h, const SelfCheckOptions& options = {},
+                const Vec3* far_position = nullptr);
 
 /// Vector area of a closed polyline (half the sum of p_i x p_i+1): the vector area of any
 /// surface it bounds.
