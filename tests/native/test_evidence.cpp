@@ -150,7 +150,7 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   e.area_ratio = 1.0;
   EXPECT_FALSE(judge(e, 3.0).holds);  // the step found is a third of h
   EXPECT_GT(judge(e, 1.0).score, judge(e, 3.0).score);
-  e.step.longest_far = 1.5;  // 1.5 h of contour away from the step
+  e.step.longest_far = 2.0;  // 2 h of contour away from the step
   const Vec3 where(1, 2, 3);
   c = judge(e, 1.0, {}, &where);
   ASSERT_EQ(c.reasons.size(), 1u);

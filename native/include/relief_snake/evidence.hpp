@@ -95,7 +95,7 @@ struct SelfCheckOptions {
   double max_area_ratio = 1.25;
   /// Longest stretch of contour (in h) allowed to run away from the step (StepEvidence::longest_far):
   /// a lobe out into the background, or a bridge across a concavity.
-  double max_far_run = 1.0;
+  double max_far_run = 1.5;
 };
 
 /// Everything the self-check looks at for one contour.
