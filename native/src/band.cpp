@@ -95,12 +95,39 @@ double share_left_of(const Mesh& mesh, const SurfacePath& a, const SurfacePath& 
   return b.empty() ? 0.0 : static_cast<double>(on_left) / static_cast<double>(b.size());
 }
 
+// The step seen from a ring into one side: local planes outside, the rise inside (evidence.hpp).
+// The pick rings lie a few h beside the step, so the ball grows (from 6 edges, doubling) until
+// half the ring sees a step, while the rise that counts stays that of the first ball (0.3 x 6
+// edges): a growing threshold would pass over a small step.
+StepEvidence side_step(const Mesh& mesh, const SurfacePath& path, const std::vector<char>& side) {
+  const double first = 6 * mesh.average_edge_length();
+  StepEvidence found;
+  for (double ball = first; ball <= 16 * first; ball *= 2) {
+    EvidenceOptions eo;
+    eo.min_rise = 0.3 * first / ball;
+    eo.outside_from = 0.5 * first / ball;
+    found = measure_step(mesh, path, side, ball, eo);
+    if (found.step_share >= 0.5) break;
+  }
+  return found;
+}
+
 struct BandAttempt {
   double h = 0;
+  double estimate = 0;    // the h the configuration started from
+  bool engraved = false;  // the walls rise away from the other ring (a groove)
+  std::vector<std::string> notes;
   RingRun first, second;
   std::vector<char> region;
   bool usable() const { return first.usable() && second.usable(); }
-  int holds() const { return int(first.check.holds) + int(second.check.holds); }
+  // Snakes that passed each other (rings on a groove's floor run as a frieze end at the far walls)
+  // leave nothing between them: no verdict holds then.
+  bool between() const {
+    for (const char f : region)
+      if (f) return true;
+    return false;
+  }
+  int holds() const { return between() ? int(first.check.holds) + int(second.check.holds) : 0; }
   double score() const { return first.check.score + second.check.score; }
   double step_found() const {
     const double a = first.evidence.step.step_height, b = second.evidence.step.step_height;
@@ -142,81 +169,104 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
   if (!decided(b_left_of_a) || !decided(a_left_of_b))
     throw Error("the two pick rings cross or touch; pick one ring on the background on each side of the band, "
                 "each going right round the surface");
-  const bool left_a = b_left_of_a > 0.5, left_b = a_left_of_b > 0.5;
+  const bool toward_left_a = b_left_of_a > 0.5, toward_left_b = a_left_of_b > 0.5;
+  const std::vector<char> toward_a = relief_region(mesh, path_a, true, toward_left_a);
+  const std::vector<char> toward_b = relief_region(mesh, path_b, true, toward_left_b);
 
   Result result;
   result.closed = true;
-  result.relief_side = left_a ? ReliefSide::Left : ReliefSide::Right;
   const bool h_given = options.step_height > 0;
-  double h = options.step_height;
-  if (!h_given) {
-    // The step seen at the first ring: local planes outside, the rise inside, with the ball
-    // grown until the step found agrees with the h it was measured with.
-    const std::vector<char> side = relief_region(mesh, path_a, true, left_a);
-    double guess = 6 * mesh.average_edge_length();
-    double found = 0;
-    for (int k = 0; k < 6; ++k) {
-      found = measure_step(mesh, path_a, side, guess).step_height;
-      if (!(found > 0)) {
-        guess *= 2;
-        continue;
-      }
-      if (std::fabs(std::log(found / guess)) < std::log(1.2)) break;
-      guess = found;
-    }
-    if (!(found > 0))
-      throw Error("could not estimate the step height of the band: nothing rises beside the first pick ring; give h");
-    h = std::clamp(found, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
-    result.step_height_estimate = h;
-    result.step_height_confidence = 0.5;
-    result.notes.push_back("h estimated from the step at the first ring's picks: " + fmt(h));
-  }
-
   SelfCheckOptions self_check;
   if (options.refit_step_height) self_check.max_step_ratio = std::max(1.5, options.refit_ratio * 1.15);
   bool cancelled = false;
-  auto attempt_at = [&](double h_try) {
-    BandAttempt a;
-    a.h = h_try;
-    PlanarityField& field = planarity(h_try, resample_path(mesh, path_a, h_try, true));
-    a.first = run_ring(mesh, field, options, h_try, path_a, left_a, self_check, progress);
-    if (a.first.run.cancelled) {
-      cancelled = true;
+
+  // One configuration: raised (a frieze, rings on the background beside it: each snake's relief
+  // side is towards the other ring) or engraved (a groove, rings on its floor: the walls rise away
+  // from the other ring). h estimated for it when not given, then refitted.
+  auto run_configuration = [&](bool engraved) {
+    const bool left_a = engraved ? !toward_left_a : toward_left_a, left_b = engraved ? !toward_left_b : toward_left_b;
+    double h = options.step_height;
+    BandAttempt none;
+    if (!h_given) {
+      std::vector<char> side_a = toward_a, side_b = toward_b;
+      if (engraved) {
+        for (char& f : side_a) f = !f;
+        for (char& f : side_b) f = !f;
+      }
+      const double a = side_step(mesh, path_a, side_a).step_height, b = side_step(mesh, path_b, side_b).step_height;
+      const double found = a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b);
+      if (!(found > 0)) return none;
+      h = std::clamp(found, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
+      none.h = h;
+    }
+    auto attempt_at = [&](double h_try) {
+      BandAttempt a;
+      a.h = h_try;
+      a.engraved = engraved;
+      a.estimate = h;
+      PlanarityField& field = planarity(h_try, resample_path(mesh, path_a, h_try, true));
+      a.first = run_ring(mesh, field, options, h_try, path_a, left_a, self_check, progress);
+      if (a.first.run.cancelled) {
+        cancelled = true;
+        return a;
+      }
+      a.second = run_ring(mesh, field, options, h_try, path_b, left_b, self_check, progress);
+      if (a.second.run.cancelled) {
+        cancelled = true;
+        return a;
+      }
+      result.attempts += a.first.attempts + a.second.attempts;
+      if (a.usable()) {
+        // The band lies towards the other ring from each contour: the relief side of a frieze's
+        // contours, the other side of a groove's.
+        a.region.assign(mesh.n_vertices(), 0);
+        for (int v = 0; v < mesh.n_vertices(); ++v)
+          a.region[v] = engraved ? (!a.first.side[v] && !a.second.side[v]) : (a.first.side[v] && a.second.side[v]);
+      }
       return a;
-    }
-    a.second = run_ring(mesh, field, options, h_try, path_b, left_b, self_check, progress);
-    if (a.second.run.cancelled) {
-      cancelled = true;
-      return a;
-    }
-    result.attempts += a.first.attempts + a.second.attempts;
-    if (a.usable()) {
-      a.region.assign(mesh.n_vertices(), 0);
-      for (int v = 0; v < mesh.n_vertices(); ++v) a.region[v] = a.first.side[v] && a.second.side[v];
-    }
-    return a;
-  };
-  BandAttempt best = attempt_at(h);
-  std::vector<double> tried = {h};
-  for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
-    const double found = best.step_found();
-    if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
-    bool near_tried = false;
-    for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
-    if (near_tried) break;
-    tried.push_back(found);
-    BandAttempt next = attempt_at(found);
-    if (cancelled) break;
-    if (!better(next, best)) break;
-    result.notes.push_back("the step along the band measured " + fmt(found) + " against h = " + fmt(best.h) +
+    };
+    BandAttempt best = attempt_at(h);
+    std::vector<double> tried = {h};
+    for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
+      const double found = best.step_found();
+      if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
+      bool near_tried = false;
+      for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
+      if (near_tried) break;
+      tried.push_back(found);
+      BandAttempt next = attempt_at(found);
+      if (cancelled) break;
+      if (!better(next, best)) break;
+      best.notes.push_back("the step along the band measured " + fmt(found) + " against h = " + fmt(best.h) +
                            "; segmented again with h = " + fmt(found));
-    best = std::move(next);
+      next.notes = best.notes;
+      best = std::move(next);
+    }
+    return best;
+  };
+  // A frieze first; a groove when the frieze's verdicts do not hold on both rings.
+  BandAttempt best = run_configuration(false);
+  if (!cancelled && best.holds() < 2) {
+    BandAttempt groove = run_configuration(true);
+    if (!cancelled && better(groove, best)) best = std::move(groove);
   }
+  const bool engraved = best.engraved;
+  const double h = best.estimate;
+  result.relief_side = (engraved ? !toward_left_a : toward_left_a) ? ReliefSide::Left : ReliefSide::Right;
+  if (!h_given && best.usable()) {
+    result.step_height_estimate = h;
+    result.step_height_confidence = 0.5;
+    result.notes.push_back("h estimated from the step beside the pick rings: " + fmt(h));
+  }
+  for (const std::string& n : best.notes) result.notes.push_back(n);
   if (cancelled) {
     Result out;
     out.status = Status::Cancelled;
     return out;
   }
+  if (!best.usable() && !h_given && !(best.h > 0))
+    throw Error("could not estimate the step height of the band: nothing rises beside the pick rings; give h, "
+                "and pick each ring on the background beside a frieze (on the floor near each wall of a groove)");
   if (!best.usable())
     throw Error("a band snake collapsed without meeting a relief step; check that h (" + fmt(best.h) +
                 ") matches the band's step and that each pick ring goes right round the surface beside the band");
@@ -277,7 +327,10 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
     result.step_height_confidence = std::clamp(1.0 - spread, 0.0, 1.0) *
                                     std::min(best.first.evidence.step.step_share, best.second.evidence.step.step_share);
   }
-  result.notes.push_back("a band: the relief lies between the two contours (contour and band_contour)");
+  result.notes.push_back(engraved ? "an engraved band: the groove between the two contours (contour and band_contour), "
+                                    "its walls rising away from the middle"
+                                  : "a band: the relief lies between the two contours (contour and band_contour)");
+  result.checks.push_back({"band_engraved", engraved ? 1.0 : 0.0});
   result.checks.push_back({"seconds", std::chrono::duration<double>(Clock::now() - t_start).count()});
   return result;
 }

@@ -371,8 +371,13 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
       search.notes.push_back("holes not searched: too little background around the relief");
     } else {
       std::vector<std::vector<int>> screened = low_sets(mesh, region, border, height, so.screen_level * h);
+      // Too small to be holes; the note counts those of at least 1 h^2 (not single low vertices).
       screened.erase(std::remove_if(screened.begin(), screened.end(),
-                                    [&](const std::vector<int>& s) { return area_of(mesh, s) < so.min_area * h * h; }),
+                                    [&](const std::vector<int>& s) {
+                                      const double a = area_of(mesh, s);
+                                      if (a < so.min_area * h * h && a >= h * h) ++search.ignored_small;
+                                      return a < so.min_area * h * h;
+                                    }),
                      screened.end());
       search.screened = static_cast<int>(screened.size());
       if (!screened.empty()) {
@@ -385,10 +390,7 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
                   [&](const auto& a, const auto& b) { return area_of(mesh, a) > area_of(mesh, b); });
         for (const std::vector<int>& island : islands) {
           const double area = area_of(mesh, island);
-          if (area < so.min_area * h * h) {
-            ++search.ignored_small;
-            continue;
-          }
+          if (area < so.min_area * h * h) continue;  // (counted by the screen)
           // A hole is surrounded by relief: the rim around it stands clearly above the background.
           std::vector<char> in(mesh.n_vertices(), 0);
           for (const int v : island) in[v] = 1;

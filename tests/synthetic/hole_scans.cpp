@@ -175,14 +175,17 @@ Scan generate_tube(const TubeSpec& ts) {
   s.average_edge = sum / static_cast<double>(seen.size());
   s.nominal_edge = s.average_edge;
   // The two band edges, dense, each right round (relief on the left seen from outside: the lower
-  // edge runs with increasing u, the upper one against it).
+  // edge runs with increasing u, the upper one against it). A frieze's at the foot of its wall
+  // (height 0); a groove's at the foot of its wall too, on the floor (height -|h|), where a contour
+  // approaching the wall from the floor settles.
+  const double foot = ts.h > 0 ? 0.0 : -depth;
   const int samples = static_cast<int>(std::ceil(C / (s.average_edge / 8)));
   Polyline lower, upper;
   for (int k = 0; k < samples; ++k) {
     const double u = C * k / samples;
-    lower.points.push_back(tube.surface(u, tube.lo(u), 0));
+    lower.points.push_back(tube.surface(u, tube.lo(u), foot));
     const double ub = C * (samples - k) / samples;
-    upper.points.push_back(tube.surface(ub, tube.hi(ub), 0));
+    upper.points.push_back(tube.surface(ub, tube.hi(ub), foot));
   }
   s.boundary = {lower, upper};
   return s;
@@ -192,8 +195,11 @@ TubePicks tube_picks(const Scan& scan, const TubeSpec& spec, int count, double d
   if (count < 3) throw Error("synthetic tube picks: count must be >= 3");
   const Tube tube{spec};
   const double C = tube.circumference(), depth = std::abs(spec.h);
-  const double v_first = -spec.half_width - std::abs(spec.wave) - distance * depth;
-  const double v_second = spec.half_width + std::abs(spec.wave) + distance * depth;
+  // A frieze: on the background beside it; engraved: on the groove's floor, near each wall.
+  const double offset = spec.h > 0 ? spec.half_width + std::abs(spec.wave) + distance * depth
+                                   : spec.half_width - std::abs(spec.wave) - distance * depth;
+  if (!(offset > 0)) throw Error("synthetic tube picks: the groove is too narrow for rings on its floor");
+  const double v_first = -offset, v_second = offset;
   auto nearest = [&](double u, double v) {
     const int i0 = static_cast<int>(std::lround(u / scan.spacing_u));
     const int j0 = static_cast<int>(std::lround((v + 0.5 * spec.length) / scan.spacing_v));

@@ -39,11 +39,12 @@ struct TubePicks {
   std::vector<std::int64_t> first, second;  ///< below the band (small y) and above it, each right round
 };
 
-/// The band scan: Scan::boundary holds the two band edges (closed), Scan::relief the band's
-/// vertices (engraved: the cut-in band). Throws Error on bad parameters.
+/// The band scan: Scan::boundary holds the two band edges (closed; engraved: at the floor, the
+/// foot of the groove's walls), Scan::relief the band's vertices (engraved: the cut-in band).
+/// Throws Error on bad parameters.
 Scan generate_tube(const TubeSpec& spec);
-/// Pick rings `distance` |h| beside the band's extreme edges, `count` picks each, in the same
-/// direction round the axis.
+/// Pick rings `distance` |h| beside the band's extreme edges (engraved: on the groove's floor,
+/// `distance` |h| inside its innermost edges), `count` picks each, in the same direction round the axis.
 TubePicks tube_picks(const Scan& scan, const TubeSpec& spec, int count = 12, double distance = 3);
 
 /// How far a result contour lies from one truth polyline, in average edges (both ways, like score()).

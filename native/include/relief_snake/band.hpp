@@ -2,17 +2,17 @@
 // Cyclic reliefs (issue 13; not in the paper): a frieze that runs right round a surface of
 // revolution, or an engraved band, bounded by two closed contours that do not enclose a disc.
 //
-// The user picks two rings, one on the background on each side of the band (Options::picks
-// the first, Options::band_picks the second). Each ring is joined like an open contour's picks
-// (plane sections, last pick back to the first, no disc test) and evolved by its own snake
-// (schedule.hpp) towards the relief: its relief side is the side the other ring lies on (which
-// ring is which tells it; rings that cross are refused). The relief region is what lies on the
-// relief side of both final contours. Each contour has its own evidence and verdict
-// (evidence.hpp); the result is doubtful when either fails.
+// The user picks two rings (Options::picks the first, Options::band_picks the second): for a
+// frieze on the background on each side of it, for an engraved band (a groove) on its floor near
+// each wall. Each ring is joined like an open contour's picks (plane sections, last pick back to
+// the first, no disc test) and evolved by its own snake (schedule.hpp) towards the step that rises
+// beside it: towards the other ring for a frieze, away from it for a groove. Which it is, is
+// measured at the rings (the step seen on each side, evidence.hpp's local planes); rings that
+// cross are refused. The band is what lies towards the other ring from both final contours. Each
+// contour has its own evidence and verdict; the result is doubtful when either fails.
 //
-// h: given, or estimated from the step measured at the first ring's picks (local planes,
-// evidence.hpp), then refitted from the step found along both final contours like a closed
-// relief's (at most twice).
+// h: given, or the step measured beside the rings, then refitted from the step found along both
+// final contours like a closed relief's (at most twice).
 #include <functional>
 #include <vector>
 

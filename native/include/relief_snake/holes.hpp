@@ -52,7 +52,7 @@ struct HoleOutcome {
 struct HoleSearch {
   std::vector<HoleOutcome> holes;
   int screened = 0;                   ///< low sets the quadric screen found (0: no background fill was needed)
-  int ignored_small = 0;              ///< islands below min_area
+  int ignored_small = 0;              ///< low sets of 1 h^2 up to min_area (smaller ones are not counted)
   int ignored_no_rim = 0;             ///< low sets without relief around them (not holes)
   bool cancelled = false;
   std::vector<std::string> notes;
