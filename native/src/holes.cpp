@@ -135,6 +135,15 @@ double area_of(const Mesh& mesh, const std::vector<int>& vertices) {
   return a;
 }
 
+double median_height(const std::vector<int>& set, const std::vector<double>& height) {
+  std::vector<double> x;
+  x.reserve(set.size());
+  for (const int v : set) x.push_back(height[v]);
+  if (x.empty()) return 0;
+  std::nth_element(x.begin(), x.begin() + static_cast<long>(x.size() / 2), x.end());
+  return x[x.size() / 2];
+}
+
 // Low sets of the region (height < level) that do not reach the outer contour.
 std::vector<std::vector<int>> low_sets(const Mesh& mesh, const std::vector<char>& region,
                                        const std::vector<char>& border, const std::vector<double>& height,
@@ -376,7 +385,7 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
                                     [&](const std::vector<int>& s) {
                                       const double a = area_of(mesh, s);
                                       if (a < so.min_area * h * h && a >= h * h) ++search.ignored_small;
-                                      return a < so.min_area * h * h;
+                                      return a < so.min_area * h * h || median_height(s, height) > so.screen_median * h;
                                     }),
                      screened.end());
       search.screened = static_cast<int>(screened.size());
@@ -391,6 +400,10 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
         for (const std::vector<int>& island : islands) {
           const double area = area_of(mesh, island);
           if (area < so.min_area * h * h) continue;  // (counted by the screen)
+          if (median_height(island, height) > so.island_median * h) {
+            ++search.ignored_no_rim;  // not down at the background: a dip in the relief
+            continue;
+          }
           // A hole is surrounded by relief: the rim around it stands clearly above the background.
           std::vector<char> in(mesh.n_vertices(), 0);
           for (const int v : island) in[v] = 1;
@@ -441,11 +454,12 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
     search.holes.push_back(std::move(run.outcome));
   }
   if (search.ignored_small > 0)
-    search.notes.push_back(std::to_string(search.ignored_small) + " background island(s) below the minimum hole area (" +
-                           fmt(so.min_area) + " h^2) were left in the relief");
+    search.notes.push_back(std::to_string(search.ignored_small) +
+                           " low area(s) inside the relief (over 1 h^2) were below the minimum hole area (" +
+                           fmt(so.min_area) + " h^2) and were not taken as holes");
   if (search.ignored_no_rim > 0)
     search.notes.push_back(std::to_string(search.ignored_no_rim) +
-                           " low area(s) inside the relief without relief standing round them were not taken as holes");
+                           " low area(s) inside the relief were not taken as holes (not down at the background, or no relief round them)");
   search.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return search;
 }

@@ -127,6 +127,22 @@ TEST(Holes, PlainReliefHasNoHoles) {
   EXPECT_EQ(r.status, Status::Converged) << r.message;
 }
 
+TEST(Holes, ReliefDroppingInsideItsEdgeIsNoHole) {
+  // The top falls to 0.3 h within 1.5 h of the edge: low, ringed by relief, but not background.
+  ScanSpec spec;
+  spec.shape = Shape::Disk;
+  spec.drop = true;
+  spec.noise = 0.05;
+  spec.triangles = 40000;
+  const Scan scan = generate(spec);
+  const Mesh mesh = to_mesh(scan);
+  Options o;
+  o.step_height = 1;
+  const Result r = segment(mesh, scan.picks().vertices, o);
+  EXPECT_TRUE(r.holes.empty());
+  EXPECT_GT(iou(r.relief_vertices, scan.relief_vertices()), 0.9);
+}
+
 TEST(Holes, SmallIslandsAreIgnored) {
   const Scan scan = generate(holed(Shape::Ring));
   const Mesh mesh = to_mesh(scan);

@@ -7,7 +7,7 @@
 // outside the contour): a plain relief has no low vertex away from its own foot, and the search
 // ends there. Otherwise the extraction's background (background.hpp, a thin-plate fill from the
 // ring) gives the heights, and every connected set of region vertices near the background
-// (below low_level h) that does not reach the outer contour, covers at least min_hole_area h^2 and
+// (below low_level h, median below island_median h) that does not reach the outer contour, covers at least min_hole_area h^2 and
 // is surrounded by relief (the rim rises above rim_level h) is an island. Each island is
 // segmented by its own snake, started on the island's outline (eroded by up to an h so it
 // starts on the floor), facing outwards: the relief lies outside a hole's contour, so the
@@ -29,8 +29,11 @@ namespace relief_snake {
 
 struct HoleSearchOptions {
   double ring_width = 3;      ///< background ring outside the outer contour, in h (the screen's quadric fit)
-  double screen_level = 0.6;  ///< the screen: region vertices below this height (in h) may be holes
-  double low_level = 0.3;     ///< an island: region vertices below this height (in h) above the fitted background
+  double screen_level = 0.45; ///< the screen: region vertices below this height (in h) may be holes ...
+  double screen_median = 0.25;  ///< ... in sets whose median height is below this (in h; a relief whose top drops
+                                ///< to 0.3 h inside its edge is no hole)
+  double low_level = 0.2;     ///< an island: region vertices below this height (in h) above the fitted background ...
+  double island_median = 0.1; ///< ... whose median height is below this (in h): the floor is background
   double rim_level = 0.5;     ///< the 75% height of the relief around an island must exceed this (in h)
   double rim_width = 2;       ///< ... measured over this distance (in h) around the island
   double min_area = 4;        ///< smaller islands are ignored, in h^2 (Options::min_hole_area)
@@ -53,7 +56,7 @@ struct HoleSearch {
   std::vector<HoleOutcome> holes;
   int screened = 0;                   ///< low sets the quadric screen found (0: no background fill was needed)
   int ignored_small = 0;              ///< low sets of 1 h^2 up to min_area (smaller ones are not counted)
-  int ignored_no_rim = 0;             ///< low sets without relief around them (not holes)
+  int ignored_no_rim = 0;             ///< low sets not down at the background or without relief around them
   bool cancelled = false;
   std::vector<std::string> notes;
   double seconds = 0;
