@@ -160,7 +160,11 @@ def apply_result(obj, result, *, group_name="Relief", make_curve=True):
     contour = result.get("contour", [])
     mesh_io.write_vertex_group(obj, group_name, relief)
     if make_curve and len(contour) >= 2:
-        mesh_io.write_curve(obj, contour, result.get("closed", True))
+        # One spline per contour: the outline, each inner hole, a band's second ring (issue 13).
+        more = list(result.get("holes") or [])
+        if result.get("band_contour"):
+            more.append(result["band_contour"])
+        mesh_io.write_curve(obj, contour, result.get("closed", True), more_contours=more)
     timing = result.setdefault("timing", {})
     timing["write"] = time.perf_counter() - t0
     timing["total"] = timing.get("read", 0.0) + timing.get("engine", 0.0) + timing["write"]

@@ -155,10 +155,12 @@ def _contour_material():
     return mat
 
 
-def write_curve(obj, contour, closed, radius=None):
+def write_curve(obj, contour, closed, radius=None, more_contours=()):
     """A 3D POLY curve through `contour` (list of (x, y, z) in obj's object space), parented to
     obj (identity parent inverse, so it sits on the mesh wherever obj is), drawn as an orange
     tube of `radius` (default: 0.6 of the mean point spacing) in front of the mesh.
+    more_contours: further closed contours (a relief's holes, a band's second ring), one more
+    spline each in the same curve object.
 
     An existing "<obj>_ReliefContour" curve object is kept and its curve data refilled.
     Returns the curve object.
@@ -176,13 +178,15 @@ def write_curve(obj, contour, closed, radius=None):
     curve = ob.data
     curve.splines.clear()
     curve.dimensions = '3D'
-    spline = curve.splines.new('POLY')
-    spline.points.add(len(contour) - 1)
-    flat = array('f')
-    for p in contour:
-        flat.extend((p[0], p[1], p[2], 1.0))
-    spline.points.foreach_set("co", flat)
-    spline.use_cyclic_u = bool(closed)
+    splines = [(contour, closed)] + [(c, True) for c in more_contours if len(c) >= 2]
+    for points, cyclic in splines:
+        spline = curve.splines.new('POLY')
+        spline.points.add(len(points) - 1)
+        flat = array('f')
+        for p in points:
+            flat.extend((p[0], p[1], p[2], 1.0))
+        spline.points.foreach_set("co", flat)
+        spline.use_cyclic_u = bool(cyclic)
     if radius is None:
         # Thick enough to read at the zoom that shows the whole outline (0.6% of its size), and
         # never thinner than its own point spacing: the refinement's half-edge spacing alone gave

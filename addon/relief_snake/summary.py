@@ -33,8 +33,14 @@ def result_summary(result):
     words = STATUS_WORDS.get(status, status.replace("_", " "))
     timing = result.get("timing", {})
     seconds = float(timing.get("total", timing.get("segment_seconds", 0.0)))
-    return "%s: %s outline of %d points, %d relief vertices, %.1f s" % (
-        words[:1].upper() + words[1:], "closed" if result.get("closed", True) else "open",
+    kind = "closed" if result.get("closed", True) else "open"
+    holes = len(result.get("holes") or [])
+    if result.get("band"):
+        kind = "band with two"
+    elif holes:
+        kind += " (%d hole%s)" % (holes, "" if holes == 1 else "s")
+    return "%s: %s outline%s of %d points, %d relief vertices, %.1f s" % (
+        words[:1].upper() + words[1:], kind, "s" if result.get("band") else "",
         len(contour), len(relief), seconds)
 
 

@@ -60,6 +60,12 @@ const char* kUsage =
     "  --open                 open contour that ends on the mesh boundary\n"
     "  --relief-side left|right|auto  with --open: side of the relief along the pick order\n"
     "                         (default auto: the side that rises)\n"
+    "  --holes auto|off       closed contours: find the relief's inner holes (background islands) and\n"
+    "                         segment each (default auto; islands under min_hole_area h^2 are ignored)\n"
+    "  --hole-picks I,J,K,... one hole's picked vertices on its floor, in order round it (repeatable,\n"
+    "                         one per hole); given hole picks replace the automatic search\n"
+    "  --band-picks I,J,K,... a band right round the surface (a frieze): --picks is the ring on one side,\n"
+    "                         this the ring on the other; the relief lies between the two contours\n"
     "  --max-iterations N     iteration cap per phase (default 3000)\n"
     "  --option NAME=VALUE    set an advanced option (repeatable; see 'advanced options' below)\n"
     "  --out FILE             write the JSON result to FILE instead of stdout\n"
@@ -281,6 +287,17 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       a.options.max_iterations = static_cast<int>(n);
     } else if (name == "--option") {
       set_advanced_option(a.options, take_value());
+    } else if (name == "--holes") {
+      const std::string mode = take_value();
+      if (mode == "auto") a.options.holes = rs::HoleMode::Auto;
+      else if (mode == "off") a.options.holes = rs::HoleMode::Off;
+      else throw UsageError("--holes must be 'auto' or 'off', got '" + mode + "'");
+    } else if (name == "--hole-picks") {
+      a.options.hole_picks.push_back(parse_picks(take_value()));
+      if (a.options.hole_picks.back().size() < 3) throw UsageError("--hole-picks needs at least 3 vertices per hole");
+    } else if (name == "--band-picks") {
+      a.options.band_picks = parse_picks(take_value());
+      if (a.options.band_picks.size() < 3) throw UsageError("--band-picks needs at least 3 vertices round the surface");
     } else if (name == "--out" || name == "-o") {
       a.out_path = take_value();
       if (a.out_path.empty()) throw UsageError("--out needs a file name");
@@ -312,6 +329,9 @@ int run_segment(const std::vector<std::string>& args) {
   double load_seconds = 0;
   const rs::Mesh mesh = load_mesh(a.mesh_path, &load_seconds);
   for (const std::int64_t p : a.picks) check_vertex(mesh, p, "pick");
+  for (const auto& hole : a.options.hole_picks)
+    for (const std::int64_t p : hole) check_vertex(mesh, p, "hole pick");
+  for (const std::int64_t p : a.options.band_picks) check_vertex(mesh, p, "band pick");
   if (!a.quiet)
     std::fprintf(stderr, "relief-snake: loaded %s in %.2f s: %s\n", a.mesh_path.c_str(), load_seconds,
                  mesh.report().summary().c_str());

@@ -387,6 +387,36 @@ double w_int_arg(py::handle value) {
   return w;
 }
 
+std::vector<std::int64_t> read_picks(py::handle picks);
+
+// Whole reliefs (issue 13): holes='auto'|'off', hole_picks=[[...], ...], min_hole_area=A (h^2),
+// band_picks=[...]. Returns false for any other keyword.
+bool whole_relief_option(Options* options, const std::string& name, py::handle value) {
+  if (name == "holes") {
+    const std::string mode = py::isinstance<py::str>(value) ? value.cast<std::string>() : std::string("?");
+    if (mode != "auto" && mode != "off")
+      throw Error("holes must be 'auto' or 'off', got " + std::string(py::str(py::repr(value))));
+    options->holes = mode == "off" ? HoleMode::Off : HoleMode::Auto;
+  } else if (name == "hole_picks") {
+    options->hole_picks.clear();
+    if (value.is_none()) return true;
+    if (!py::isinstance<py::sequence>(value) || py::isinstance<py::str>(value))
+      throw Error("hole_picks must be a list of pick lists, one per hole, e.g. [[1, 2, 3], [7, 8, 9]]");
+    for (py::handle hole : value) options->hole_picks.push_back(read_picks(hole));
+  } else if (name == "band_picks") {
+    options->band_picks = value.is_none() ? std::vector<std::int64_t>{} : read_picks(value);
+  } else if (name == "min_hole_area") {
+    if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()))
+      throw py::type_error("min_hole_area must be a number (in h^2)");
+    const double a = py::float_(py::reinterpret_borrow<py::object>(value));
+    if (!std::isfinite(a) || a < 0) throw Error("min_hole_area must be a number >= 0 (in h^2)");
+    options->min_hole_area = a;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 Options make_options(py::handle step_height_value, py::handle w_int_value, bool open_contour,
                      const std::string& relief_side, int max_iterations, const py::kwargs& advanced) {
   const double step_height = step_height_arg(step_height_value);
@@ -404,6 +434,7 @@ Options make_options(py::handle step_height_value, py::handle w_int_value, bool 
   options.max_iterations = max_iterations;
   for (const auto& [key, value] : advanced) {
     const std::string name = py::str(key);
+    if (whole_relief_option(&options, name, value)) continue;
     const OptionInfo* info = nullptr;
     for (const OptionInfo& o : advanced_options())
       if (name == o.name) info = &o;
@@ -456,6 +487,15 @@ py::dict result_dict(const Result& r, const Options& o, const Mesh& mesh, const 
   py::list contour;
   for (const Vec3& p : r.polyline) contour.append(point(p));
   out["contour"] = contour;
+  py::list holes, band_contour;
+  for (const std::vector<Vec3>& hole : r.hole_polylines) {
+    py::list line;
+    for (const Vec3& p : hole) line.append(point(p));
+    holes.append(line);
+  }
+  for (const Vec3& p : r.band_polyline) band_contour.append(point(p));
+  out["holes"] = holes;
+  out["band_contour"] = band_contour;
   return out;
 }
 
@@ -626,6 +666,10 @@ PYBIND11_MODULE(relief_snake_core, m) {
       "step_height; checks; phases; parameters; notes; mesh; timing), the same as the CLI writes.\n"
       "allow_partial=True skips (and reports in the result's mesh) triangles with out-of-range corners or\n"
       "non-finite vertices instead of raising.\n"
+      "Whole reliefs (issue 13): holes='auto'|'off' (closed contours: find and segment inner holes),\n"
+      "hole_picks=[[i, j, k, ...], ...] (one pick list per hole, on its floor; replaces the search),\n"
+      "min_hole_area=4 (in h^2), band_picks=[...] (a band round the surface: picks is the ring on one side,\n"
+      "band_picks the other; result 'band_contour'). The result's 'holes' lists each hole's contour.\n"
       "**advanced: the engine's advanced options by name (e.g. tau=0.2, exact_q=True); advanced_options()\n"
       "lists them with their types, ranges and defaults. An unknown name raises TypeError.";
 

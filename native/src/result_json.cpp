@@ -32,6 +32,21 @@ json mesh_report_json(const Mesh& mesh, const std::string& path) {
 json to_json(const Result& result, const Options& options, const Mesh& mesh, const ResultContext& context) {
   json contour = json::array();
   for (const Vec3& p : result.polyline) contour.push_back({p.x(), p.y(), p.z()});
+  // Whole reliefs (issue 13): the holes' contours and checks, the band's second contour.
+  json holes = json::array(), hole_checks = json::array(), band_contour = json::array();
+  for (const std::vector<Vec3>& hole : result.hole_polylines) {
+    json line = json::array();
+    for (const Vec3& p : hole) line.push_back({p.x(), p.y(), p.z()});
+    holes.push_back(std::move(line));
+  }
+  for (const auto& named : result.hole_checks) {
+    json c = json::object();
+    for (const auto& [name, value] : named) c[name] = value;
+    if (c.contains("holds")) c["holds"] = c["holds"].get<double>() != 0;
+    if (c.contains("from_picks")) c["from_picks"] = c["from_picks"].get<double>() != 0;
+    hole_checks.push_back(std::move(c));
+  }
+  for (const Vec3& p : result.band_polyline) band_contour.push_back({p.x(), p.y(), p.z()});
   json phases = json::array();
   for (const PhaseStats& s : result.phases)
     phases.push_back({{"name", s.name},
@@ -42,7 +57,11 @@ json to_json(const Result& result, const Options& options, const Mesh& mesh, con
   json parameters = {{"open", !options.closed},
                      {"relief_side", to_string(result.relief_side)},
                      {"picks", context.picks},
-                     {"max_iterations", options.max_iterations}};
+                     {"max_iterations", options.max_iterations},
+                     {"holes", to_string(options.holes)},
+                     {"hole_picks", options.hole_picks},
+                     {"min_hole_area", options.min_hole_area},
+                     {"band_picks", options.band_picks}};
   for (const OptionInfo& option : advanced_options())
     parameters[option.name] = json::parse(advanced_option_json(options, option.name));
   // The values used (h, W_int and what derives from them), whether given or chosen.
@@ -62,6 +81,10 @@ json to_json(const Result& result, const Options& options, const Mesh& mesh, con
               {"relief_side", result.closed ? json(nullptr) : json(to_string(result.relief_side))},
               {"contour", contour},
               {"relief_vertices", result.relief_vertices},
+              {"holes", holes},
+              {"hole_checks", hole_checks},
+              {"band", !result.band_polyline.empty()},
+              {"band_contour", band_contour},
               {"step_height", step_height},
               {"w_int", {{"used", result.parameters.w_int},
                          {"given", options.w_int > 0 ? json(options.w_int) : json(nullptr)}}},

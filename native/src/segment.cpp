@@ -11,6 +11,8 @@
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/evolution.hpp"
 #include "relief_snake/foot.hpp"
+#include "relief_snake/holes.hpp"
+#include "relief_snake/band.hpp"
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/planarity.hpp"
 #include "relief_snake/region.hpp"
@@ -197,6 +199,16 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   validate_options(mesh, options);
   const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
   const int component = mesh.component(pick_vertices.front());
+  validate_hole_picks(mesh, options, component);
+  if (!options.band_picks.empty()) {  // a cyclic relief between two rings (band.cpp)
+    const std::vector<int> band_vertices = validate_picks(mesh, options.band_picks, true);
+    return segment_band(mesh, pick_vertices, band_vertices, options,
+                        [&](double h_band, const std::vector<SurfacePoint>& start) -> PlanarityField& {
+                          return planarity_for(mesh, cache_->planarity, cache_->options, cache_->tree, options,
+                                               h_band, start, component);
+                        },
+                        progress);
+  }
 
   Result result;
   result.closed = options.closed;
@@ -428,6 +440,15 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     result.step_height_confidence = refitted ? from_contour : std::max(result.step_height_confidence, from_contour);
   }
 
+  // --- inner holes (holes.cpp): cleared from the region; a failed hole makes the result doubtful
+  if (options.closed && (options.holes == HoleMode::Auto || !options.hole_picks.empty())) {
+    PlanarityField& planarity = planarity_for(mesh, cache_->planarity, cache_->options, cache_->tree, options,
+                                              best.h, best.run.contour, component);
+    const HoleSearch holes = segment_holes(mesh, planarity, options, best.h, &best.region, progress);
+    if (holes.cancelled) return cancelled_result();
+    add_holes(mesh, holes, &result, &best.check);
+  }
+
   result.contour = best.run.contour;
   result.polyline.reserve(result.contour.size());
   for (const SurfacePoint& p : result.contour) result.polyline.push_back(position(mesh, p));
@@ -437,7 +458,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   }
 
   const StepEvidence& step = best.evidence.step;
-  result.checks = {{"step_share", step.step_share},
+  result.checks.insert(result.checks.begin(), {{"step_share", step.step_share},
                    {"step_height", step.step_height},
                    {"rise_median", step.rise_median},
                    {"step_spread", step.step_spread},
@@ -455,7 +476,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"offset_q90", step.offset_q90 / best.h},
                    {"offset_q95", step.offset_q95 / best.h},
                    {"far_share", step.far_share},
-                   {"far_run", step.longest_far / best.h}};
+                   {"far_run", step.longest_far / best.h}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (best.run.hit_cap) {

@@ -666,3 +666,68 @@ class OpenContour(AddonTestCase):
         score = iou(group_members(self.obj, "Relief"), self.truth["relief_vertices"])
         self.assertLess(score, 0.5, "the wrong relief side still gave IoU %.3f" % score)
 
+
+
+def ring_scan(n=120, size=40.0, inner=5.0, outer=12.0):
+    """A raised annulus (h = 1, a sharp step) on a flat grid: a relief with one inner hole.
+    Returns the scan dict for make_scan_object, the picks round it and the truth's relief set."""
+    step = size / (n - 1)
+    vertices, faces, relief = [], [], set()
+    for j in range(n):
+        for i in range(n):
+            x, y = -0.5 * size + i * step, -0.5 * size + j * step
+            r = math.hypot(x, y)
+            up = inner < r < outer
+            if up:
+                relief.add(len(vertices))
+            vertices.append((x, y, 1.0 if up else 0.0))
+    for j in range(n - 1):
+        for i in range(n - 1):
+            a, b, c, d = j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i
+            faces += [(a, b, c), (a, c, d)]
+    picks = []
+    for k in range(10):
+        t = 2 * math.pi * k / 10
+        x, y = 15.0 * math.cos(t), 15.0 * math.sin(t)
+        picks.append(int(round((y + 0.5 * size) / step)) * n + int(round((x + 0.5 * size) / step)))
+    return {"vertices": vertices, "faces": faces}, picks, relief
+
+
+class WholeReliefs(AddonTestCase):
+    """Issue 13: one curve object with one spline per contour; the group leaves the holes out."""
+
+    def test_each_contour_is_a_spline_of_one_curve(self):
+        api = addon().api
+        outline = [(math.cos(t) * 10, math.sin(t) * 10, 0.0) for t in (2 * math.pi * k / 40 for k in range(40))]
+        hole_a = [(p[0] * 0.3 - 3, p[1] * 0.3, 0.0) for p in outline]
+        hole_b = [(p[0] * 0.3 + 3, p[1] * 0.3, 0.0) for p in outline]
+        result = {"contour": outline, "closed": True, "holes": [hole_a, hole_b], "band_contour": [],
+                  "relief_vertices": [0, 1, 2]}
+        api.apply_result(self.obj, result)
+        curve = bpy.data.objects[self.obj.name + "_ReliefContour"]
+        self.assertEqual(len(curve.data.splines), 3)
+        self.assertTrue(all(s.use_cyclic_u for s in curve.data.splines))
+        self.assertEqual([len(s.points) for s in curve.data.splines], [40, 40, 40])
+        self.assertEqual(group_members(self.obj, "Relief"), {0, 1, 2})
+        # A second result without holes refills the same object with one spline.
+        api.apply_result(self.obj, {"contour": outline, "closed": True, "relief_vertices": [0]})
+        self.assertEqual(len(bpy.data.objects[self.obj.name + "_ReliefContour"].data.splines), 1)
+
+    def test_ring_hole_is_left_out_of_the_group(self):
+        clear_scene()
+        scan, picks, truth = ring_scan()
+        obj = make_scan_object("Ring", scan=scan)
+        api = addon().api
+        result = api.segment_object(obj, picks, 1.0)
+        self.assertEqual(len(result["holes"]), 1, result.get("message"))
+        curve = bpy.data.objects[obj.name + "_ReliefContour"]
+        self.assertEqual(len(curve.data.splines), 2)
+        members = group_members(obj, "Relief")
+        self.assertGreaterEqual(iou(members, truth), 0.9)
+        centre = 60 * 120 + 60  # (0.17, 0.17): in the hole
+        self.assertNotIn(centre, members)
+        # holes='off' keeps the island in the relief and draws the outline alone.
+        result = api.segment_object(obj, picks, 1.0, options={"holes": "off"})
+        self.assertEqual(result["holes"], [])
+        self.assertIn(centre, group_members(obj, "Relief"))
+        self.assertEqual(len(bpy.data.objects[obj.name + "_ReliefContour"].data.splines), 1)

@@ -23,6 +23,14 @@ class Summaries(unittest.TestCase):
         self.assertEqual(summary.timing_line(dict(RESULT, mesh_cached=True)),
                          "Blender data 0.12 s (read 0.10, write 0.02), engine 2.30 s (mesh reused)")
 
+    def test_holes_and_bands_are_counted(self):
+        self.assertEqual(summary.result_summary(dict(RESULT, holes=[[(0, 0, 0)] * 3] * 2)),
+                         "Done: closed (2 holes) outline of 5 points, 3 relief vertices, 2.5 s")
+        self.assertEqual(summary.result_summary(dict(RESULT, holes=[[(0, 0, 0)] * 3])),
+                         "Done: closed (1 hole) outline of 5 points, 3 relief vertices, 2.5 s")
+        self.assertEqual(summary.result_summary(dict(RESULT, band=True, band_contour=[(0, 0, 0)] * 4)),
+                         "Done: band with two outlines of 5 points, 3 relief vertices, 2.5 s")
+
     def test_converged_has_no_warning(self):
         self.assertIsNone(summary.status_warning(RESULT))
 

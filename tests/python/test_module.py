@@ -397,7 +397,9 @@ def test_result_dict_structure(scan, disk_result):
     # The same document the CLI writes (docs/result-format.md).
     assert set(r) == {"format", "status", "message", "reasons", "closed", "relief_side", "contour",
                       "relief_vertices", "step_height", "w_int", "checks", "attempts", "phases", "parameters",
-                      "notes", "planarity_vertices", "mesh", "timing"}
+                      "notes", "planarity_vertices", "mesh", "timing",
+                      "holes", "hole_checks", "band", "band_contour"}  # whole reliefs (issue 13)
+    assert r["holes"] == [] and r["hole_checks"] == [] and r["band"] is False and r["band_contour"] == []
     assert r["format"] == "relief-snake-result/1"
     assert r["status"] == "converged" and r["reasons"] == [] and r["relief_side"] is None
     assert r["closed"] is True

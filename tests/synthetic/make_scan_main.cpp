@@ -14,6 +14,7 @@
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
 #include "synthetic.hpp"
+#include "hole_scans.hpp"
 
 namespace rs = relief_snake;
 namespace syn = relief_snake::synthetic;
@@ -25,12 +26,17 @@ const char* kUsage =
     "  make-scan [options] --out PREFIX        writes PREFIX.ply (or .obj) and PREFIX.truth.json\n"
     "  make-scan --random SEED --out PREFIX    one scan of the random family: PREFIX.ply, PREFIX.json (truth),\n"
     "                                          PREFIX.background.npy (per vertex base, normal, heights)\n"
+    "  make-scan tube [--radius R] [--vase A] [--h H (< 0: engraved)] [--half-width W] [--wave A] [--waves N]\n"
+    "            [--step sharp|blended] [--noise S] [--triangles N] [--seed K] [--picks N] [--distance D] --out PREFIX\n"
+    "                                          a band right round a cylinder or vase: truth boundary = both band edges,\n"
+    "                                          picks and band_picks = one pick ring on each side\n"
     "  make-scan score TRUTH.json RESULT.json [--mesh MESH]\n"
     "                                          prints {iou, mean/p95/max distances both ways, in average edges};\n"
     "                                          with --mesh also iou_area (vertex-area weighted) and the one-edge\n"
     "                                          IoU floors (truth against truth grown by one average edge)\n"
     "options (defaults in brackets):\n"
-    "  --shape duck|disk|rectangle|slots|open|gear|c|ellipse|rounded-box|letter|band [duck]\n"
+    "  --shape duck|disk|rectangle|slots|open|gear|c|ellipse|rounded-box|letter|band|ring|holed-letter [duck]\n"
+    "  --letter O|D|A|B (holed-letter)   --stroke-width W [7]   --ring-radius R [13]   --ring-half-thickness T [4]\n"
     "  --background plane|cylinder|sphere|saddle|vase|wavy [plane]   --texture none|striations|dots [none]\n"
     "  --triangles N [100000]   --h H [1]   --seed K [1]   --radius R [40]   --width W [80]   --height H [56]\n"
     "  --step sharp|blended [sharp]   --blend-width B [0.5, in h]   --detail A [0, fraction of h]   --drop\n"
@@ -170,6 +176,7 @@ int run(int argc, char** argv) {
     if (args.size() != 3) throw rs::Error("score needs two files: make-scan score TRUTH.json RESULT.json [--mesh MESH]");
     return run_score(args[1], args[2], "");
   }
+  if (args[0] == "tube") return syn::tube_command(std::vector<std::string>(args.begin() + 1, args.end()));
   if (args[0] == "--random") {
     if (args.size() != 4 || args[2] != "--out")
       throw rs::Error("--random needs a seed and an output prefix: make-scan --random SEED --out PREFIX");
@@ -216,6 +223,10 @@ int run(int argc, char** argv) {
       else if (a == "--far-distance") picks.far_distance = std::stod(value());
       else if (a == "--reverse") picks.reverse = true;
       else if (a == "--format") format = value();
+      else if (a == "--letter") spec.letter = value().at(0);
+      else if (a == "--stroke-width") spec.stroke_width = std::stod(value());
+      else if (a == "--ring-radius") spec.c_radius = std::stod(value());
+      else if (a == "--ring-half-thickness") spec.c_half_thickness = std::stod(value());
       else if (a == "--out") out = value();
       else throw rs::Error("unknown option " + a + " (see make-scan --help)");
     } catch (const std::logic_error& e) {  // std::stod and friends
@@ -232,7 +243,9 @@ int run(int argc, char** argv) {
   const std::string mesh_path = out + "." + format, truth_path = out + ".truth.json";
   if (format == "ply") syn::write_ply(scan, mesh_path);
   else syn::write_obj(scan, mesh_path);
-  syn::write_truth_json(scan, p, truth_path);
+  nlohmann::json truth = syn::truth_json(scan, p);
+  syn::add_hole_truth(scan, &truth);  // "holes": the hole boundaries (issue 13)
+  syn::write_json(truth, truth_path);
   const auto t2 = std::chrono::steady_clock::now();
   nlohmann::json summary = {{"mesh", mesh_path},
                             {"truth", truth_path},

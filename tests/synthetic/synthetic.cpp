@@ -267,7 +267,10 @@ Shape parse_shape(const std::string& n) {
   if (n == "rounded-box") return Shape::RoundedBox;
   if (n == "letter") return Shape::Letter;
   if (n == "band") return Shape::Band;
-  throw Error("unknown shape '" + n + "': use duck, disk, rectangle, slots, open, gear, c, ellipse, rounded-box, letter or band");
+  if (n == "ring") return Shape::Ring;
+  if (n == "holed-letter") return Shape::HoledLetter;
+  throw Error("unknown shape '" + n + "': use duck, disk, rectangle, slots, open, gear, c, ellipse, rounded-box, letter, "
+              "band, ring or holed-letter");
 }
 Background parse_background(const std::string& n) {
   if (n == "plane") return Background::Plane;
@@ -302,6 +305,8 @@ const char* to_string(Shape s) {
     case Shape::RoundedBox: return "rounded-box";
     case Shape::Letter: return "letter";
     case Shape::Band: return "band";
+    case Shape::Ring: return "ring";
+    case Shape::HoledLetter: return "holed-letter";
   }
   return "?";
 }
@@ -392,6 +397,8 @@ double Scan::signed_distance(double u, double v) const {
       return sd_box(u, v, 0, 0, spec.box_half_u - r, spec.box_half_v - r) - r;
     }
     case Shape::Letter: return sd_letter(u, v, spec.letter, spec.letter_half_u, spec.letter_half_v, spec.stroke_width);
+    case Shape::Ring:
+    case Shape::HoledLetter: return holed_shape_distance(spec, u, v);
     case Shape::Band: {
       double d = 1e300;
       for (std::size_t k = 0; k + 3 < band.size(); k += 2)

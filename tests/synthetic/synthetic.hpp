@@ -35,6 +35,9 @@ enum class Shape {
   RoundedBox, ///< box of half sizes box_half_u, box_half_v with corners rounded by box_corner
   Letter,     ///< block letter `letter` (L, T, E, H, U) of half sizes letter_half_u/v, strokes stroke_width wide
   Band,       ///< band of half width band_half_width along an arc entering from a domain edge (open boundary)
+  // Reliefs with inner holes (hole_scans.cpp):
+  Ring,         ///< annulus of centre radius c_radius and half thickness c_half_thickness: one hole
+  HoledLetter,  ///< block letter `letter` with counters (O, D, A, B), half sizes letter_half_u/v, strokes stroke_width
 };
 enum class Background {
   Plane,     ///< z = 0
@@ -63,6 +66,9 @@ enum class Start {
 /// Parse/print the enums by their lower-case names ("duck", "saddle", "blended", "zigzag").
 /// parse_* throw Error on an unknown name.
 Shape parse_shape(const std::string& name);
+struct ScanSpec;
+/// Signed distance of the shapes with holes (Ring, HoledLetter; hole_scans.cpp), in the shape's frame.
+double holed_shape_distance(const ScanSpec& spec, double u, double v);
 Background parse_background(const std::string& name);
 Step parse_step(const std::string& name);
 Start parse_start(const std::string& name);

@@ -18,6 +18,10 @@ namespace relief_snake {
 enum class ReliefSide { Left, Right, Auto };
 const char* to_string(ReliefSide side);
 
+/// Options::holes: look for background islands inside a closed relief (holes.hpp), or not.
+enum class HoleMode { Auto, Off };
+const char* to_string(HoleMode mode);
+
 /// Options::step_height and Options::w_int: let the engine choose.
 constexpr double kAuto = 0.0;
 
@@ -71,6 +75,18 @@ struct Options {
   Neighbourhood neighbourhood = Neighbourhood::Sphere;
   PlaneFit plane_fit = PlaneFit::VertexAreas;
   bool planarity_one_ring = true;  ///< the one-ring always counts as neighbours (not in the paper)
+
+  // Whole reliefs (issue 13; holes.hpp, band.hpp).
+  /// Closed contours: after the outer contour settles, find background islands inside the relief
+  /// and segment each with its own snake (Auto), or not (Off). Given hole_picks replace the search.
+  HoleMode holes = HoleMode::Auto;
+  /// Holes from picks: per hole, input vertex indices in order on the hole's floor around it (>= 3 each).
+  std::vector<std::vector<std::int64_t>> hole_picks;
+  /// Islands smaller than this (in h^2) are not holes (noise, engraved dots).
+  double min_hole_area = 4;
+  /// A cyclic relief (a frieze round a surface of revolution): the second pick ring, the picks
+  /// then being the first; the relief lies between the two rings (band.hpp). Empty: not a band.
+  std::vector<std::int64_t> band_picks;
 };
 
 enum class Status {
@@ -123,6 +139,15 @@ struct Result {
   double step_height_estimate = 0;
   double step_height_confidence = 1;
   int attempts = 0;                      ///< refinement runs tried (W_int and h choices)
+
+  /// Inner holes (holes.hpp): each hole's final snaxels and 3D polyline (the relief lies outside
+  /// them; relief_vertices excludes what they enclose), and each hole's checks by name.
+  std::vector<std::vector<SurfacePoint>> holes;
+  std::vector<std::vector<Vec3>> hole_polylines;
+  std::vector<std::vector<std::pair<std::string, double>>> hole_checks;
+  /// Cyclic reliefs (band.hpp): the second ring's final snaxels and polyline (contour is the first's).
+  std::vector<SurfacePoint> band_contour;
+  std::vector<Vec3> band_polyline;
 };
 
 /// What the progress callback sees (valid only during the call).
