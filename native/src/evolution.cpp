@@ -129,8 +129,8 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
         if (use_feature)
           for (int t = 0; t < 3; ++t) feature.trace(p.candidate[t], p.inward, &zero, 1, &p.trace[t]);
       } else {
-        p.candidate[1] = walk(mesh, s.point, p.inward, step).end;
-        p.candidate[2] = walk(mesh, s.point, -p.inward, step).end;
+        p.candidate[1] = walk(mesh, s.point, p.inward, WalkOptions{step}).end;
+        p.candidate[2] = walk(mesh, s.point, -p.inward, WalkOptions{step}).end;
         p.traces = 1;
         // The candidates lie on the bisector through the snaxel: one walk along it
         // holds the q windows of all three.

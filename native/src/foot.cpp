@@ -44,7 +44,11 @@ double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOp
   const int count = static_cast<int>(std::ceil(o.band_to * h / step));
   distances->resize(count + 1);
   for (int k = 0; k <= count; ++k) (*distances)[k] = k * step;
-  walk_sampled(mesh, snake[i].point, -inward, *distances, samples);
+  WalkOptions walk_options;
+  walk_options.distance = distances->back();
+  walk_options.samples = distances->data();
+  walk_options.n_samples = distances->size();
+  *samples = walk_points(walk(mesh, snake[i].point, -inward, walk_options));
   if (static_cast<int>(samples->size()) <= count) return -1;  // the mesh ends before the band does
 
   // The background's normal: the surface normal averaged over the band.
@@ -155,7 +159,7 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   std::vector<SurfacePoint> target(n);
   for (int i = 0; i < n; ++i) {
     target[i] = (*snake)[i].point;
-    if (smoothed[i] > 0) target[i] = walk(snake->mesh(), (*snake)[i].point, -inward[i], smoothed[i]).end;
+    if (smoothed[i] > 0) target[i] = walk(snake->mesh(), (*snake)[i].point, -inward[i], WalkOptions{smoothed[i]}).end;
   }
   double total = 0;
   for (int i = 0; i < n; ++i) {

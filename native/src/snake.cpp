@@ -36,7 +36,11 @@ std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& 
   for (double t : fractions) distances.push_back(t * d);
   std::vector<SurfacePoint> out;
   if (d <= 0) return std::vector<SurfacePoint>(fractions.size(), a);
-  walk_sampled(mesh, a, pb - pa, distances, &out);
+  WalkOptions walk_options;
+  walk_options.distance = distances.empty() ? 0 : distances.back();
+  walk_options.samples = distances.data();
+  walk_options.n_samples = distances.size();
+  out = walk_points(walk(mesh, a, pb - pa, walk_options));
   // A boundary can cut the walk short: fill the rest with the last point reached.
   while (out.size() < fractions.size()) out.push_back(out.empty() ? a : out.back());
   if (nearest) {
