@@ -94,10 +94,6 @@ class Snake {
   std::uint64_t version_ = 0;  // changes so far (stamps)
   std::uint64_t turns_checked_ = 0, spacing_checked_ = 0, loops_checked_ = 0;  // version_ when each last looked
   double spacing_l_ = -1;      // the l of the last resample()
-  // remove_loops() buffers: a hash grid of segment boxes, reused between calls.
-  std::vector<std::uint32_t> grid_start_;
-  std::vector<std::uint64_t> grid_keys_;
-  std::vector<std::pair<std::uint64_t, int>> grid_entries_;
 };
 
 /// Points on the surface between a and b at fractions t_k of their distance: the
