@@ -168,6 +168,28 @@ void Snake::move(int i, const SurfacePoint& p) {
   snaxels_[i].stamp = ++version_;
 }
 
+void Snake::take_moved_flags(std::vector<char>* moved_before) {
+  moved_before->resize(snaxels_.size());
+  for (std::size_t i = 0; i < snaxels_.size(); ++i) {
+    (*moved_before)[i] = snaxels_[i].moved;
+    snaxels_[i].moved = false;
+  }
+}
+
+void Snake::step(int i, const SurfacePoint& p) {
+  move(i, p);
+  snaxels_[i].moved = true;
+}
+
+void Snake::update_locks(int interval, double distance) {
+  for (Snaxel& s : snaxels_) {
+    if (++s.age < interval || s.locked) continue;
+    if ((s.position - s.anchor).norm() < distance) s.locked = true;
+    s.anchor = s.position;
+    s.age = 0;
+  }
+}
+
 Vec3 Snake::inward(int i) const {
   const Vec3& x = snaxels_[i].position;
   const Vec3 n = normal(mesh_, snaxels_[i].point);
