@@ -43,8 +43,8 @@ void check_pick_count(std::size_t count, bool closed) {
 int checked_input_vertex(const Mesh& mesh, std::int64_t index, const std::string& what) {
   const std::size_t n = mesh.input_vertex_count();
   if (index < 0 || static_cast<std::size_t>(index) >= n)
-    throw Error(what + " " + std::to_string(index) + " is out of range: the mesh file has " + std::to_string(n) +
-                " vertices (indices are 0-based)");
+    throw Error(what + " " + std::to_string(index) + " is not a vertex index, out of range: the mesh file has " +
+                std::to_string(n) + " vertices (indices are 0-based)");
   const int v = mesh.input_to_mesh(static_cast<std::size_t>(index));
   if (v < 0)
     throw Error(what + " " + std::to_string(index) +

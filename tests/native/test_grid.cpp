@@ -53,15 +53,6 @@ void expect_grid_matches_brute_force(const Vec3& offset, double cell) {
   }
 }
 
-SurfacePoint point_at(const Mesh& mesh, const Vec3& target) {
-  int best = 0;
-  for (int v = 1; v < mesh.n_vertices(); ++v)
-    if ((mesh.position(v) - target).norm() < (mesh.position(best) - target).norm()) best = v;
-  const SurfacePoint start = vertex_point(mesh, best);
-  const Vec3 d = target - mesh.position(best);
-  return d.norm() > 0 ? walk(mesh, start, d, WalkOptions{d.norm()}).end : start;
-}
-
 }  // namespace
 
 TEST(Grid, NeighboursMatchBruteForceNearTheOrigin) { expect_grid_matches_brute_force(Vec3::Zero(), 0.5); }
@@ -99,11 +90,13 @@ TEST(Grid, SnakeLoopRemovalAndConvergenceCheckFarFromTheOrigin) {
   const double scale = 1e-3;
   const Mesh mesh = test::grid_mesh(41, 41, 20 * scale, 20 * scale,
                                     [&](double u, double v) { return Vec3(offset.x() + u, offset.y() + v, 0); });
-  const Vec3 c = offset + Vec3(10, 10, 0) * scale;
+  // The circle's points: straight walks of its radius from the centre vertex (20, 20).
+  const SurfacePoint centre = vertex_point(mesh, 20 * 41 + 20);
+  const Vec3 c = position(mesh, centre);
   std::vector<SurfacePoint> pts;
   for (int k = 0; k < 24; ++k) {
     const double a = 2 * M_PI * k / 24;
-    pts.push_back(point_at(mesh, c + 5 * scale * Vec3(std::cos(a), std::sin(a), 0)));
+    pts.push_back(walk(mesh, centre, Vec3(std::cos(a), std::sin(a), 0), WalkOptions{5 * scale}).end);
   }
   std::swap(pts[6], pts[7]);
   Snake snake(mesh, pts, true, true);

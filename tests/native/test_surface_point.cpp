@@ -185,26 +185,28 @@ TEST(SurfacePoint, WalkStretchHoldsTheExtremesOfALinearField) {
 }
 
 TEST(SurfacePoint, WalkRecordsSamplesAndCrossingsInWalkingOrder) {
-  // Along x on a grid of unit cells the walk crosses a vertical edge at every integer x
-  // (and a diagonal in each cell); samples carry their index, crossings tag -1, all in
-  // order of distance, crossings only inside the range asked for.
+  // Across a grid of unit cells, slightly off the x axis: the walk crosses a vertical edge
+  // about every unit (and diagonals in between). Samples carry their index, crossings tag -1,
+  // all in order of distance, crossings only inside the range asked for.
   const Mesh mesh = test::grid_mesh(11, 11, 10, 10, [](double u, double v) { return Vec3(u, v, 0); });
-  const SurfacePoint start = point_near(mesh, Vec3(1.25, 5.5, 0));
+  const SurfacePoint start = point_near(mesh, Vec3(1, 5, 0));
+  const Vec3 from = position(mesh, start);
+  const Vec3 dir = Vec3(1, 0.13, 0).normalized();
   const double samples[3] = {0.5, 2.0, 3.5};
   WalkOptions options;
   options.distance = 4.0;
   options.samples = samples;
   options.n_samples = 3;
-  const WalkResult plain = walk(mesh, start, Vec3(1, 0, 0), options);
+  const WalkResult plain = walk(mesh, start, dir, options);
   ASSERT_EQ(plain.points.size(), 3u);
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(plain.points[k].tag, k);
-    EXPECT_NEAR(position(mesh, plain.points[k].point).x(), 1.25 + samples[k], 1e-9);
+    EXPECT_NEAR((position(mesh, plain.points[k].point) - (from + samples[k] * dir)).norm(), 0, 1e-9);
   }
   options.record_crossings = true;
   options.crossings_from = 1.0;
   options.crossings_to = 3.0;
-  const WalkResult traced = walk(mesh, start, Vec3(1, 0, 0), options);
+  const WalkResult traced = walk(mesh, start, dir, options);
   int crossings = 0;
   double last = -1;
   for (const WalkPoint& p : traced.points) {
@@ -214,12 +216,13 @@ TEST(SurfacePoint, WalkRecordsSamplesAndCrossingsInWalkingOrder) {
     ++crossings;
     EXPECT_GE(p.distance, 1.0 - 1e-12);
     EXPECT_LE(p.distance, 3.0 + 1e-12);
+    EXPECT_NEAR((position(mesh, p.point) - (from + p.distance * dir)).norm(), 0, 1e-9);
   }
-  EXPECT_GE(crossings, 2);  // at least x = 3 and x = 4 (distances 1.75 and 2.75)
+  EXPECT_GE(crossings, 2);  // at least the vertical edges x = 3 and x = 4
   EXPECT_EQ(static_cast<int>(traced.points.size()) - crossings, 3);
   // Nothing asked for, nothing recorded; the end is the same.
-  const WalkResult bare = walk(mesh, start, Vec3(1, 0, 0), WalkOptions{4.0});
+  const WalkResult bare = walk(mesh, start, dir, WalkOptions{4.0});
   EXPECT_TRUE(bare.points.empty());
   EXPECT_EQ(bare.end.face, traced.end.face);
-  EXPECT_NEAR(position(mesh, bare.end).x(), 5.25, 1e-9);
+  EXPECT_NEAR((position(mesh, bare.end) - (from + 4.0 * dir)).norm(), 0, 1e-9);
 }
