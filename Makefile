@@ -2,6 +2,8 @@
 PYTHON ?= python3
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
+# Warnings are errors in `make build` (so in CI); WERROR=OFF to build past them locally.
+WERROR ?= ON
 
 .PHONY: deps build test test-native test-python test-blender test-package test-blender-ui demo clean wheel package bench bench-random fuzz
 
@@ -9,7 +11,7 @@ deps:
 	@scripts/install-deps.sh
 
 build: deps
-	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$$(command -v $(PYTHON)) >/dev/null
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRELIEF_SNAKE_WERROR=$(WERROR) -DPython3_EXECUTABLE=$$(command -v $(PYTHON)) >/dev/null
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test-native: build

@@ -1,5 +1,6 @@
 // relief-snake extract: base surface, relief mesh and height map from a segmentation result.
 #include "extract_command.hpp"
+#include "parse_number.hpp"
 
 #include <cerrno>
 #include <chrono>
@@ -38,11 +39,8 @@ struct ExtractUsage : std::runtime_error {
 };
 
 double positive_number(const std::string& text, const std::string& what) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value) || !(value > 0))
-    throw ExtractUsage(what + " must be a positive number, got '" + text + "'");
+  const double value = parse_number<ExtractUsage>(text, what);
+  if (!(value > 0)) throw ExtractUsage(what + " must be a positive number, got '" + text + "'");
   return value;
 }
 

@@ -26,7 +26,9 @@
 
 #include "batch_command.hpp"
 #include "extract_command.hpp"
+#include "parse_number.hpp"
 #include "relief_snake/error.hpp"
+#include "relief_snake/input_checks.hpp"
 #include "relief_snake/option_table.hpp"
 #include "relief_snake/result_json.hpp"
 #include "relief_snake/mesh.hpp"
@@ -119,27 +121,11 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 double parse_number(const std::string& text, const std::string& what) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size())
-    throw UsageError(what + " must be a number, got '" + text + "'");
-  if (!std::isfinite(value) && errno != ERANGE) throw UsageError(what + " must be a finite number, got '" + text + "'");
-  if (errno == ERANGE && std::abs(value) > 1)
-    throw UsageError(what + " " + text + " is too large for double precision (beyond 1.8e308)");
-  if (errno == ERANGE)
-    throw UsageError(what + " " + text + " is too small for double precision (below 2.2e-308); give it in mesh units");
-  return value;
+  return rs::cli::parse_number<UsageError>(text, what);
 }
 
 std::int64_t parse_index(const std::string& text, const std::string& what) {
-  errno = 0;
-  char* end = nullptr;
-  const long long value = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE)
-    throw UsageError(what + " must be a whole number, got '" + text + "'");
-  if (value < 0) throw UsageError(what + " must be >= 0 (indices are 0-based), got " + text);
-  return value;
+  return rs::cli::parse_index<UsageError>(text, what);
 }
 
 std::vector<std::int64_t> parse_picks(const std::string& text) {
@@ -174,14 +160,14 @@ rs::Mesh load_mesh(const std::string& path, double* load_seconds) {
   return mesh;
 }
 
-void check_vertex(const rs::Mesh& mesh, std::int64_t index, const std::string& what) {
-  const std::size_t n = mesh.input_vertex_count();
-  if (index < 0 || static_cast<std::size_t>(index) >= n)
-    throw rs::Error(what + " " + std::to_string(index) + " is out of range: the mesh file has " + std::to_string(n) +
-                    " vertices (indices are 0-based)");
-  if (mesh.input_to_mesh(static_cast<std::size_t>(index)) < 0)
-    throw rs::Error(what + " " + std::to_string(index) +
-                    " is in no face of the mesh (unused or in a refused face); pick a vertex on the surface");
+/// The engine's check of what the user typed (input_checks.hpp), its Error as a usage error.
+template <class Check>
+auto usage_checked(const Check& check) {
+  try {
+    return check();
+  } catch (const rs::Error& e) {
+    throw UsageError(e.what());
+  }
 }
 
 
@@ -258,15 +244,16 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       a.picks = parse_picks(take_value());
       a.have_picks = true;
     } else if (name == "--step-height") {
-      const std::string value = take_value();
-      a.options.step_height = value == "auto" ? rs::kAuto : parse_number(value, "--step-height");
-      if (value != "auto" && !(a.options.step_height > 0)) throw UsageError("--step-height must be > 0 or auto");
+      const std::string typed = take_value();
+      a.options.step_height = typed == "auto" ? rs::kAuto : usage_checked([&] {
+        return rs::checked_step_height(parse_number(typed, "--step-height"), "--step-height");
+      });
       a.have_height = true;
     } else if (name == "--w-int") {
-      const std::string value = take_value();
-      a.options.w_int = value == "auto" ? rs::kAuto : parse_number(value, "--w-int");
-      if (value != "auto" && !(a.options.w_int > 0 && a.options.w_int <= 1))
-        throw UsageError("--w-int must be in (0, 1] or auto");
+      const std::string typed = take_value();
+      a.options.w_int = typed == "auto" ? rs::kAuto : usage_checked([&] {
+        return rs::checked_w_int(parse_number(typed, "--w-int"), "--w-int");
+      });
     } else if (name == "--open") {
       no_value();
       a.options.closed = false;
@@ -317,10 +304,10 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
   a.mesh_path = positional[0];
   if (!a.have_picks) throw UsageError("segment needs --picks I,J,K,... (0-based vertex indices around the relief)");
   if (a.have_side && a.options.closed) throw UsageError("--relief-side only applies with --open");
-  const std::size_t min_picks = a.options.closed ? 3 : 2;
-  if (a.picks.size() < min_picks)
-    throw UsageError(std::string("--picks needs at least ") + std::to_string(min_picks) + " vertices for " +
-                     (a.options.closed ? "a closed" : "an open") + " contour");
+  usage_checked([&] {
+    rs::check_pick_count(a.picks.size(), a.options.closed);
+    return 0;
+  });
   return a;
 }
 
@@ -328,10 +315,10 @@ int run_segment(const std::vector<std::string>& args) {
   const SegmentArgs a = parse_segment(args);
   double load_seconds = 0;
   const rs::Mesh mesh = load_mesh(a.mesh_path, &load_seconds);
-  for (const std::int64_t p : a.picks) check_vertex(mesh, p, "pick");
+  for (const std::int64_t p : a.picks) rs::checked_input_vertex(mesh, p, "pick");
   for (const auto& hole : a.options.hole_picks)
-    for (const std::int64_t p : hole) check_vertex(mesh, p, "hole pick");
-  for (const std::int64_t p : a.options.band_picks) check_vertex(mesh, p, "band pick");
+    for (const std::int64_t p : hole) rs::checked_input_vertex(mesh, p, "hole pick");
+  for (const std::int64_t p : a.options.band_picks) rs::checked_input_vertex(mesh, p, "band pick");
   if (!a.quiet)
     std::fprintf(stderr, "relief-snake: loaded %s in %.2f s: %s\n", a.mesh_path.c_str(), load_seconds,
                  mesh.report().summary().c_str());

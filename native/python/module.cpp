@@ -17,6 +17,7 @@
 #include <exception>
 #include <stdexcept>
 #include <type_traits>
+#include <variant>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -25,6 +26,7 @@
 
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
+#include "relief_snake/input_checks.hpp"
 #include "relief_snake/option_table.hpp"
 #include "relief_snake/result_json.hpp"
 #include "relief_snake/segment.hpp"
@@ -325,9 +327,9 @@ std::unique_ptr<Mesh> build_mesh(py::handle vertices, py::handle triangles, bool
 
 // --- segmentation ---------------------------------------------------------------
 
-/// The text form of an advanced option's value, checked against its type (a Python bool for
-/// booleans, an int for whole numbers, a str for choices); the option table checks the range.
-std::string option_text(const OptionInfo& info, py::handle value) {
+/// An advanced option's value as the engine's OptionValue, checked against its type (a Python
+/// bool for booleans, an int for whole numbers, a str for choices); the option table checks the range.
+OptionValue option_arg(const OptionInfo& info, py::handle value) {
   const bool is_bool = PyBool_Check(value.ptr());
   const bool is_int = !is_bool && PyLong_Check(value.ptr());
   const bool is_float = PyFloat_Check(value.ptr());
@@ -340,13 +342,17 @@ std::string option_text(const OptionInfo& info, py::handle value) {
   switch (info.type) {
     case OptionType::Boolean:
       if (!is_bool) throw wrong("True or False");
-      return value.ptr() == Py_True ? "true" : "false";
-    case OptionType::Integer:
+      return value.ptr() == Py_True;
+    case OptionType::Integer: {
       if (!is_int) throw wrong("an int");
-      return std::string(py::str(value));
+      int overflow = 0;
+      const long long n = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+      if (overflow) throw wrong("an int");
+      return n;
+    }
     case OptionType::Number:
       if (!is_int && !is_float) throw wrong("a number");
-      return std::string(py::str(py::repr(py::float_(py::reinterpret_borrow<py::object>(value)))));
+      return static_cast<double>(py::float_(py::reinterpret_borrow<py::object>(value)));
     case OptionType::Choice:
       if (!PyUnicode_Check(value.ptr())) throw wrong("a str");
       return value.cast<std::string>();
@@ -356,22 +362,25 @@ std::string option_text(const OptionInfo& info, py::handle value) {
 
 /// An advanced option's value as a Python object: float, int, bool or str by its type.
 py::object option_value(const Options& options, const OptionInfo& info) {
-  py::object value = py::module_::import("json").attr("loads")(advanced_option_json(options, info.name));
-  return info.type == OptionType::Number ? py::float_(value) : value;
+  return std::visit(
+      [](const auto& v) -> py::object {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>) return py::bool_(v);
+        else if constexpr (std::is_same_v<T, long long>) return py::int_(v);
+        else if constexpr (std::is_same_v<T, double>) return py::float_(v);
+        else return py::str(v);
+      },
+      advanced_option_value(options, info.name));
 }
 
-// step_height: None (estimate it) or a number > 0; w_int: None or "auto" (the engine
-// chooses) or a number in (0, 1]. Range checks beyond these are the engine's (validate_options).
+// step_height: None (estimate it) or a number; w_int: None or "auto" (the engine chooses) or a
+// number. The types are checked here, the values by the engine (input_checks.hpp).
 double step_height_arg(py::handle value) {
   if (value.is_none()) return kAuto;
   if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()))
     throw py::type_error("step_height must be a number > 0 or None (estimate it), got " +
                          std::string(py::str(py::repr(value))));
-  const double h = py::float_(py::reinterpret_borrow<py::object>(value));
-  if (!std::isfinite(h) || h <= 0)
-    throw Error("step_height must be a finite number > 0, or None to estimate it (got " +
-                std::string(py::str(py::repr(value))) + ")");
-  return h;
+  return checked_step_height(py::float_(py::reinterpret_borrow<py::object>(value)), "step_height");
 }
 
 double w_int_arg(py::handle value) {
@@ -382,9 +391,7 @@ double w_int_arg(py::handle value) {
   }
   if (PyBool_Check(value.ptr()) || !PyNumber_Check(value.ptr()))
     throw py::type_error("w_int must be a number in (0, 1] or 'auto', got " + std::string(py::str(py::repr(value))));
-  const double w = py::float_(py::reinterpret_borrow<py::object>(value));
-  if (!std::isfinite(w) || w <= 0 || w > 1) throw Error("w_int must be in (0, 1] or 'auto'; the paper uses 0.25");
-  return w;
+  return checked_w_int(py::float_(py::reinterpret_borrow<py::object>(value)), "w_int");
 }
 
 std::vector<std::int64_t> read_picks(py::handle picks);
@@ -423,7 +430,6 @@ Options make_options(py::handle step_height_value, py::handle w_int_value, bool 
   const double w_int = w_int_arg(w_int_value);
   if (relief_side != "left" && relief_side != "right" && relief_side != "auto")
     throw Error("relief_side must be \"left\", \"right\" or \"auto\", got \"" + relief_side + "\"");
-  if (max_iterations < 1) throw Error("max_iterations must be at least 1");
   Options options;
   options.step_height = step_height;
   options.w_int = w_int;
@@ -441,7 +447,7 @@ Options make_options(py::handle step_height_value, py::handle w_int_value, bool 
     if (!info)
       throw py::type_error("segment() got an unexpected keyword argument '" + name +
                            "'; the advanced options are: " + advanced_option_names());
-    set_advanced_option(&options, name, option_text(*info, value));
+    set_advanced_option_value(&options, name, option_arg(*info, value));
   }
   return options;
 }

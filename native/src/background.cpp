@@ -1,4 +1,5 @@
 #include "relief_snake/background.hpp"
+#include "relief_snake/plane_fit.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -97,23 +98,16 @@ struct HeightFieldFrame {
 /// (a projected face turns over), so it is no height field there.
 bool make_height_field(const Mesh& mesh, const std::vector<char>& region, const std::vector<int>& ring,
                        const std::vector<int>& rows, HeightFieldFrame* frame) {
-  Vec3 centroid = Vec3::Zero(), mean_normal = Vec3::Zero();
-  for (const int v : ring) {
-    centroid += mesh.position(v);
-    mean_normal += mesh.vertex_normal(v);
-  }
-  centroid /= static_cast<double>(ring.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const int v : ring) covariance += (mesh.position(v) - centroid) * (mesh.position(v) - centroid).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-  Vec3 n = eigen.eigenvectors().col(0);
-  if (n.dot(mean_normal) < 0) n = -n;
+  // The plane: unit weights (the ring is one band of vertices, sampled like the scan).
+  const VertexPlaneFit plane = fit_vertex_plane(mesh, ring, false);
+  if (plane.weight <= 0) return false;  // no ring: no frame to fit
+  const Vec3 centroid = plane.centroid, n = plane.normal;
   frame->origin = centroid;
   frame->n = n;
-  frame->e1 = eigen.eigenvectors().col(2);
+  frame->e1 = plane.axes.col(2);
   frame->e1 = (frame->e1 - frame->e1.dot(n) * n).normalized();
   frame->e2 = n.cross(frame->e1);
-  frame->scale = std::sqrt(std::max(eigen.eigenvalues()(2) / static_cast<double>(ring.size()), 1e-30));
+  frame->scale = std::sqrt(std::max(plane.eigenvalues(2) / static_cast<double>(ring.size()), 1e-30));
   // Every face around the rows must keep its orientation in the plane.
   std::vector<char> seen(static_cast<std::size_t>(mesh.n_faces()), 0);
   for (const int v : rows)

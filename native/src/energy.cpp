@@ -76,8 +76,14 @@ void FeatureEnergy::trace(const SurfacePoint& x, const Vec3& inward, const doubl
   std::sort(wanted.begin(), wanted.begin() + n);
   std::array<double, 3 * 64 + 6> distances;
   for (int i = 0; i < n; ++i) distances[i] = wanted[i].first;
-  walk_trace(planarity_.mesh(), x, inward, distances.data(), n, exact_q_ ? q_from_ + lo : 0, exact_q_ ? q_to_ + hi : -1,
-             &out->points);
+  WalkOptions walk_options;
+  walk_options.distance = n > 0 ? distances[n - 1] : 0;
+  walk_options.samples = distances.data();
+  walk_options.n_samples = n;
+  walk_options.record_crossings = exact_q_;
+  walk_options.crossings_from = q_from_ + lo;
+  walk_options.crossings_to = q_to_ + hi;
+  out->points = walk(planarity_.mesh(), x, inward, walk_options).points;
   for (WalkPoint& p : out->points)
     if (p.tag >= 0) p.tag = wanted[p.tag].second;
 }

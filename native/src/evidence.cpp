@@ -1,5 +1,6 @@
 // Step evidence along a contour: local background planes outside, heights inside.
 #include "relief_snake/evidence.hpp"
+#include "relief_snake/plane_fit.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -90,8 +91,6 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     // The background plane: area-weighted least squares over the outside vertices.
     outside.clear();
     near_outside.clear();
-    double weight = 0;
-    Vec3 mean = Vec3::Zero(), normal_sum = Vec3::Zero();
     int inside_count = 0;
     for (const int v : ball) {
       if (region[v]) {
@@ -103,24 +102,13 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
         continue;
       }
       outside.push_back(v);
-      const double a = mesh.vertex_area(v);
-      weight += a;
-      mean += a * mesh.position(v);
-      normal_sum += a * mesh.vertex_normal(v);
     }
+    const VertexPlaneFit plane = fit_vertex_plane(mesh, outside);
     if (inside_count < options.min_side_vertices || static_cast<int>(outside.size()) < options.min_side_vertices ||
-        weight <= 0)
+        plane.weight <= 0)
       continue;
-    mean /= weight;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const int v : outside) {
-      const Vec3 d = mesh.position(v) - mean;
-      cov += mesh.vertex_area(v) * d * d.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
-    Vec3 normal = solver.eigenvectors().col(0);
-    if (normal.dot(normal_sum) < 0) normal = -normal;
-    const double residual = std::sqrt(std::max(0.0, solver.eigenvalues()[0]) / weight);
+    const Vec3 mean = plane.centroid, normal = plane.normal;
+    const double residual = plane.residual();
 
     heights.clear();
     for (const int v : ball)

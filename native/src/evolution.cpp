@@ -73,11 +73,7 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
   GreedyWorkspace& w = *workspace;
   const Mesh& mesh = snake.mesh();
   const int n = snake.size();
-  w.moved_before.resize(n);
-  for (int i = 0; i < n; ++i) {
-    w.moved_before[i] = snake[i].moved;
-    snake[i].moved = false;
-  }
+  snake.take_moved_flags(&w.moved_before);
   auto evaluated = [&](int i) {
     // If it and its neighbours stood still last time, its energies are unchanged.
     const int ip = snake.prev(i), in = snake.next(i);
@@ -129,8 +125,8 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
         if (use_feature)
           for (int t = 0; t < 3; ++t) feature.trace(p.candidate[t], p.inward, &zero, 1, &p.trace[t]);
       } else {
-        p.candidate[1] = walk(mesh, s.point, p.inward, step).end;
-        p.candidate[2] = walk(mesh, s.point, -p.inward, step).end;
+        p.candidate[1] = walk(mesh, s.point, p.inward, WalkOptions{step}).end;
+        p.candidate[2] = walk(mesh, s.point, -p.inward, WalkOptions{step}).end;
         p.traces = 1;
         // The candidates lie on the bisector through the snaxel: one walk along it
         // holds the q windows of all three.
@@ -187,8 +183,7 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
     for (int k = 0; k < count; ++k) {
       const GreedyProbe& p = w.probes[k];
       if (p.decision == 0) continue;
-      snake.move(p.i, p.candidate[p.decision]);
-      snake[p.i].moved = true;
+      snake.step(p.i, p.candidate[p.decision]);
       ++moved;
     }
   }
@@ -207,13 +202,7 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
 
     // Oscillation lock (Section 6.1): every lock_interval iterations, a snaxel
     // that got less than 2 tau l from where it was is frozen for the phase.
-    for (int i = 0; i < snake.size(); ++i) {
-      Snaxel& s = snake[i];
-      if (++s.age < phase.lock_interval || s.locked) continue;
-      if ((s.position - s.anchor).norm() < lock_distance) s.locked = true;
-      s.anchor = s.position;
-      s.age = 0;
-    }
+    snake.update_locks(phase.lock_interval, lock_distance);
     changes += snake.remove_sharp_turns(phase.max_turn_degrees);
     changes += snake.resample(phase.l);
     if (phase.remove_loops) changes += snake.remove_loops();

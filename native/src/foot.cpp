@@ -4,12 +4,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Dense>
 
-#include "grid_key.hpp"
+#include "grid.hpp"
 
 namespace relief_snake {
 
@@ -44,7 +43,11 @@ double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOp
   const int count = static_cast<int>(std::ceil(o.band_to * h / step));
   distances->resize(count + 1);
   for (int k = 0; k <= count; ++k) (*distances)[k] = k * step;
-  walk_sampled(mesh, snake[i].point, -inward, *distances, samples);
+  WalkOptions walk_options;
+  walk_options.distance = distances->back();
+  walk_options.samples = distances->data();
+  walk_options.n_samples = distances->size();
+  *samples = walk_points(walk(mesh, snake[i].point, -inward, walk_options));
   if (static_cast<int>(samples->size()) <= count) return -1;  // the mesh ends before the band does
 
   // The background's normal: the surface normal averaged over the band.
@@ -128,26 +131,24 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   // sides must not meet.
   {
     const double cell = 0.5 * o.h;
-    std::unordered_map<std::uint64_t, std::vector<int>> grid;
-    for (int i = 0; i < n; ++i) grid[grid_key(grid_cell((*snake)[i].position, cell))].push_back(i);
+    HashGrid grid(n > 0 ? (*snake)[0].position : Vec3::Zero(), cell);
+    for (int i = 0; i < n; ++i) grid.add(grid.cell_of((*snake)[i].position), i);
+    grid.build();
     const int apart = 4 * o.smoothing + 4;  // snaxels closer along the snake are its own side
     for (int i = 0; i < n; ++i) {
       if (!(smoothed[i] > 0)) continue;
       const Vec3& p = (*snake)[i].position;
-      const Eigen::Array3i c = grid_cell(p, cell);
+      const HashGrid::Cell c = grid.cell_of(p);
       double nearest = std::numeric_limits<double>::infinity();
       const int reach = static_cast<int>(std::ceil(smoothed[i] / (0.4 * cell))) + 1;
       for (int x = -reach; x <= reach; ++x)
         for (int y = -reach; y <= reach; ++y)
-          for (int z = -reach; z <= reach; ++z) {
-            const auto it = grid.find(grid_key(c + Eigen::Array3i(x, y, z)));
-            if (it == grid.end()) continue;
-            for (int j : it->second) {
+          for (int z = -reach; z <= reach; ++z)
+            grid.for_each(c + HashGrid::Cell(x, y, z), [&](int j) {
               int gap = std::abs(i - j);
               if (snake->closed()) gap = std::min(gap, n - gap);
               if (gap > apart) nearest = std::min(nearest, ((*snake)[j].position - p).norm());
-            }
-          }
+            });
       smoothed[i] = std::min(smoothed[i], 0.4 * nearest);
     }
   }
@@ -155,7 +156,7 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   std::vector<SurfacePoint> target(n);
   for (int i = 0; i < n; ++i) {
     target[i] = (*snake)[i].point;
-    if (smoothed[i] > 0) target[i] = walk(snake->mesh(), (*snake)[i].point, -inward[i], smoothed[i]).end;
+    if (smoothed[i] > 0) target[i] = walk(snake->mesh(), (*snake)[i].point, -inward[i], WalkOptions{smoothed[i]}).end;
   }
   double total = 0;
   for (int i = 0; i < n; ++i) {

@@ -26,14 +26,6 @@ int leading_zeros(unsigned x) { return x == 0 ? 32 : __builtin_clz(x); }
 
 double cone_angle(double c) { return std::acos(std::clamp(c, -1.0, 1.0)); }
 
-// Squared distances from p to the nearest and the farthest point of the box [lo, hi].
-double min_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  return (p.cwiseMax(lo).cwiseMin(hi) - p).squaredNorm();
-}
-double max_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  return (p - lo).cwiseAbs().cwiseMax((p - hi).cwiseAbs()).squaredNorm();
-}
-
 }  // namespace
 
 Vec3 MomentTree::element_normal(int e) const {

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <functional>
 #include <sstream>
+#include <utility>
+#include <variant>
 
 #include "relief_snake/error.hpp"
 
@@ -14,13 +16,10 @@ namespace {
 
 struct Row {
   OptionInfo info;
-  std::function<void(Options&, const std::string&)> set;  // text already known to be well-formed for the type
-  std::function<std::string(const Options&)> json;
+  /// Sets the field from a value of the row's type (checked by the caller); false if out of range.
+  std::function<bool(Options&, const OptionValue&)> set;
+  std::function<OptionValue(const Options&)> get;
 };
-
-[[noreturn]] void bad_value(const OptionInfo& info, const std::string& text) {
-  throw Error(std::string("option ") + info.name + " must be " + info.range + ", got '" + text + "'");
-}
 
 // The shortest decimal text that reads back as exactly x ("0.2", not "0.20000000000000001").
 std::string number_json(double x) {
@@ -33,81 +32,112 @@ std::string number_json(double x) {
   return std::to_string(x);
 }
 
+// How a value is shown in messages.
+std::string shown(const OptionValue& value) {
+  if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+  if (const long long* n = std::get_if<long long>(&value)) return std::to_string(*n);
+  if (const double* x = std::get_if<double>(&value)) return number_json(*x);
+  return std::get<std::string>(value);
+}
+
+[[noreturn]] void bad_value(const OptionInfo& info, const std::string& text) {
+  throw Error(std::string("option ") + info.name + " must be " + info.range + ", got '" + text + "'");
+}
+
+// Whole-number options are ints; larger values are refused before the cast.
+constexpr long long kLargestInteger = 100000000;
+
 Row number(const char* name, double Options::*field, const char* range, bool (*valid)(double), const char* help) {
-  const OptionInfo info{name, OptionType::Number, range, help};
-  return {info,
-          [=](Options& o, const std::string& text) {
-            errno = 0;
-            char* end = nullptr;
-            const double x = std::strtod(text.c_str(), &end);
-            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(x) || !valid(x))
-              bad_value(info, text);
+  return {OptionInfo{name, OptionType::Number, range, help},
+          [=](Options& o, const OptionValue& v) {
+            const double x = std::get<double>(v);
+            if (!std::isfinite(x) || !valid(x)) return false;
             o.*field = x;
+            return true;
           },
-          [=](const Options& o) { return number_json(o.*field); }};
+          [=](const Options& o) { return OptionValue(o.*field); }};
 }
 
 Row integer(const char* name, int Options::*field, const char* range, bool (*valid)(long long), const char* help) {
-  const OptionInfo info{name, OptionType::Integer, range, help};
-  return {info,
-          [=](Options& o, const std::string& text) {
-            errno = 0;
-            char* end = nullptr;
-            const long long n = std::strtoll(text.c_str(), &end, 10);
-            if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || n > 100000000 || !valid(n))
-              bad_value(info, text);
+  return {OptionInfo{name, OptionType::Integer, range, help},
+          [=](Options& o, const OptionValue& v) {
+            const long long n = std::get<long long>(v);
+            if (n > kLargestInteger || !valid(n)) return false;
             o.*field = static_cast<int>(n);
+            return true;
           },
-          [=](const Options& o) { return std::to_string(o.*field); }};
+          [=](const Options& o) { return OptionValue(static_cast<long long>(o.*field)); }};
 }
 
 Row boolean(const char* name, bool Options::*field, const char* help) {
-  const OptionInfo info{name, OptionType::Boolean, "0, 1, true or false", help};
-  return {info,
-          [=](Options& o, const std::string& text) {
-            if (text == "1" || text == "true") o.*field = true;
-            else if (text == "0" || text == "false") o.*field = false;
-            else bad_value(info, text);
+  return {OptionInfo{name, OptionType::Boolean, "0, 1, true or false", help},
+          [=](Options& o, const OptionValue& v) {
+            o.*field = std::get<bool>(v);
+            return true;
           },
-          [=](const Options& o) { return std::string(o.*field ? "true" : "false"); }};
+          [=](const Options& o) { return OptionValue(o.*field); }};
+}
+
+// A choice between named values of an enum.
+template <class Enum>
+Row choice(const char* name, Enum Options::*field, const char* range,
+           std::vector<std::pair<const char*, Enum>> names, const char* help) {
+  return {OptionInfo{name, OptionType::Choice, range, help},
+          [=](Options& o, const OptionValue& v) {
+            const std::string& text = std::get<std::string>(v);
+            for (const auto& [n, e] : names)
+              if (text == n) {
+                o.*field = e;
+                return true;
+              }
+            return false;
+          },
+          [=](const Options& o) {
+            for (const auto& [n, e] : names)
+              if (o.*field == e) return OptionValue(std::string(n));
+            return OptionValue(std::string("?"));
+          }};
 }
 
 Row neighbourhood(const char* name, Neighbourhood Options::*field, const char* help) {
-  const OptionInfo info{name, OptionType::Choice, "geodesic, euclidean or sphere", help};
-  return {info,
-          [=](Options& o, const std::string& text) {
-            if (text == "geodesic") o.*field = Neighbourhood::Geodesic;
-            else if (text == "euclidean") o.*field = Neighbourhood::Euclidean;
-            else if (text == "sphere") o.*field = Neighbourhood::Sphere;
-            else bad_value(info, text);
-          },
-          [=](const Options& o) {
-            switch (o.*field) {
-              case Neighbourhood::Geodesic: return std::string("\"geodesic\"");
-              case Neighbourhood::Euclidean: return std::string("\"euclidean\"");
-              case Neighbourhood::Sphere: return std::string("\"sphere\"");
-            }
-            return std::string("\"?\"");
-          }};
+  return choice(name, field, "geodesic, euclidean or sphere",
+                {{"geodesic", Neighbourhood::Geodesic}, {"euclidean", Neighbourhood::Euclidean},
+                 {"sphere", Neighbourhood::Sphere}},
+                help);
 }
 
 Row plane_fit(const char* name, PlaneFit Options::*field, const char* help) {
-  const OptionInfo info{name, OptionType::Choice, "vertices, vertex_areas or area", help};
-  return {info,
-          [=](Options& o, const std::string& text) {
-            if (text == "vertices") o.*field = PlaneFit::Vertices;
-            else if (text == "vertex_areas") o.*field = PlaneFit::VertexAreas;
-            else if (text == "area") o.*field = PlaneFit::Area;
-            else bad_value(info, text);
-          },
-          [=](const Options& o) {
-            switch (o.*field) {
-              case PlaneFit::Vertices: return std::string("\"vertices\"");
-              case PlaneFit::VertexAreas: return std::string("\"vertex_areas\"");
-              case PlaneFit::Area: return std::string("\"area\"");
-            }
-            return std::string("\"?\"");
-          }};
+  return choice(name, field, "vertices, vertex_areas or area",
+                {{"vertices", PlaneFit::Vertices}, {"vertex_areas", PlaneFit::VertexAreas}, {"area", PlaneFit::Area}},
+                help);
+}
+
+// The text form (the CLI's --option NAME=VALUE) as a value of the row's type.
+OptionValue parse_text(const OptionInfo& info, const std::string& text) {
+  switch (info.type) {
+    case OptionType::Number: {
+      errno = 0;
+      char* end = nullptr;
+      const double x = std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(x))
+        bad_value(info, text);
+      return x;
+    }
+    case OptionType::Integer: {
+      errno = 0;
+      char* end = nullptr;
+      const long long n = std::strtoll(text.c_str(), &end, 10);
+      if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE) bad_value(info, text);
+      return n;
+    }
+    case OptionType::Boolean:
+      if (text == "1" || text == "true") return true;
+      if (text == "0" || text == "false") return false;
+      bad_value(info, text);
+    case OptionType::Choice:
+      return text;
+  }
+  bad_value(info, text);
 }
 
 const std::vector<Row>& rows() {
@@ -181,16 +211,45 @@ std::string advanced_option_names() {
   return names;
 }
 
-void set_advanced_option(Options* options, const std::string& name, const std::string& value) {
+namespace {
+
+const Row& row_of(const std::string& name) {
   const Row* row = find(name);
   if (!row) throw Error("unknown option '" + name + "'; valid names: " + advanced_option_names());
-  row->set(*options, value);
+  return *row;
+}
+
+}  // namespace
+
+void set_advanced_option(Options* options, const std::string& name, const std::string& value) {
+  const Row& row = row_of(name);
+  if (!row.set(*options, parse_text(row.info, value))) bad_value(row.info, value);
+}
+
+void set_advanced_option_value(Options* options, const std::string& name, const OptionValue& value) {
+  const Row& row = row_of(name);
+  OptionValue typed = value;
+  // A whole number is a number too.
+  if (row.info.type == OptionType::Number && std::holds_alternative<long long>(value))
+    typed = static_cast<double>(std::get<long long>(value));
+  const bool right_type =
+      (row.info.type == OptionType::Number && std::holds_alternative<double>(typed)) ||
+      (row.info.type == OptionType::Integer && std::holds_alternative<long long>(typed)) ||
+      (row.info.type == OptionType::Boolean && std::holds_alternative<bool>(typed)) ||
+      (row.info.type == OptionType::Choice && std::holds_alternative<std::string>(typed));
+  if (!right_type || !row.set(*options, typed)) bad_value(row.info, shown(value));
+}
+
+OptionValue advanced_option_value(const Options& options, const std::string& name) {
+  return row_of(name).get(options);
 }
 
 std::string advanced_option_json(const Options& options, const std::string& name) {
-  const Row* row = find(name);
-  if (!row) throw Error("unknown option '" + name + "'; valid names: " + advanced_option_names());
-  return row->json(options);
+  const OptionValue value = advanced_option_value(options, name);
+  if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+  if (const long long* n = std::get_if<long long>(&value)) return std::to_string(*n);
+  if (const double* x = std::get_if<double>(&value)) return number_json(*x);
+  return "\"" + std::get<std::string>(value) + "\"";
 }
 
 }  // namespace relief_snake

@@ -1,5 +1,8 @@
 #include "relief_snake/plane_fit.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Eigenvalues>
 
 namespace relief_snake {
@@ -69,6 +72,37 @@ double planarity_about_vertex(const PlaneMoments& m, const Vec3& vn) {
     if (normal.dot(vn) < 0) normal = -normal;
   }
   return centroid.dot(normal);
+}
+
+double VertexPlaneFit::residual() const {
+  return weight > 0 ? std::sqrt(std::max(0.0, eigenvalues[0]) / weight) : 0.0;
+}
+
+VertexPlaneFit fit_vertex_plane(const Mesh& mesh, const std::vector<int>& vertices, bool area_weighted) {
+  VertexPlaneFit fit;
+  double weight = 0;
+  Vec3 mean = Vec3::Zero(), normal_sum = Vec3::Zero();
+  for (const int v : vertices) {
+    const double a = area_weighted ? mesh.vertex_area(v) : 1.0;
+    weight += a;
+    mean += a * mesh.position(v);
+    normal_sum += a * mesh.vertex_normal(v);
+  }
+  if (weight <= 0) return fit;
+  mean /= weight;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const int v : vertices) {
+    const Vec3 d = mesh.position(v) - mean;
+    cov += (area_weighted ? mesh.vertex_area(v) : 1.0) * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  fit.weight = weight;
+  fit.centroid = mean;
+  fit.axes = solver.eigenvectors();
+  fit.eigenvalues = solver.eigenvalues();
+  fit.normal = fit.axes.col(0);
+  if (fit.normal.dot(normal_sum) < 0) fit.normal = -fit.normal;
+  return fit;
 }
 
 }  // namespace relief_snake

@@ -19,6 +19,7 @@
 #include "relief_snake/schedule.hpp"
 #include "relief_snake/snake.hpp"
 #include "relief_snake/step_height.hpp"
+#include "relief_snake/input_checks.hpp"
 
 namespace relief_snake {
 
@@ -65,9 +66,7 @@ std::string fmt(double x) {
 
 void validate_options(const Mesh& mesh, const Options& o) {
   const double h = o.step_height;
-  if (!std::isfinite(h) || h < 0)
-    throw Error("step height h must be a positive number, or auto (got " + fmt(h) +
-                "); measure the relief's step with the measure tool");
+  if (h != kAuto) checked_step_height(h);
   // A step far below the mesh's resolution cannot be resolved, and the snake would need
   // (length / h) snaxels: refuse instead of running away.
   if (h > 0 && h < 0.1 * mesh.average_edge_length())
@@ -76,8 +75,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
   if (h > mesh.bbox_diagonal())
     throw Error("step height h = " + fmt(h) + " is larger than the whole mesh (diagonal " +
                 fmt(mesh.bbox_diagonal()) + "); check the units of h");
-  if (!std::isfinite(o.w_int) || o.w_int < 0 || o.w_int > 1)
-    throw Error("W_int must be in (0, 1] (got " + fmt(o.w_int) + "); try 0.25, then halve it if concavities are missed");
+  if (o.w_int != kAuto) checked_w_int(o.w_int);
   if (!(o.tau > 0 && o.tau < 1)) throw Error("tau must be in (0, 1) (got " + fmt(o.tau) + ")");
   if (!(o.epsilon >= 0 && o.epsilon < 1)) throw Error("epsilon must be in [0, 1) (got " + fmt(o.epsilon) + ")");
   if (o.q_samples < 1 || o.q_samples > 64) throw Error("q_samples must be between 1 and 64 (the paper uses 5)");
@@ -93,20 +91,12 @@ void validate_options(const Mesh& mesh, const Options& o) {
 }
 
 std::vector<int> validate_picks(const Mesh& mesh, const std::vector<std::int64_t>& picks, bool closed) {
-  const std::size_t needed = closed ? 3 : 2;
-  if (picks.size() < needed)
-    throw Error(std::string(closed ? "a closed contour" : "an open contour") + " needs at least " +
-                std::to_string(needed) + " picked vertices (got " + std::to_string(picks.size()) +
-                "); pick vertices around the relief");
+  check_pick_count(picks.size(), closed);
   std::vector<int> out;
   std::unordered_set<int> seen;
   for (std::size_t k = 0; k < picks.size(); ++k) {
     const std::int64_t p = picks[k];
-    if (p < 0 || static_cast<std::size_t>(p) >= mesh.input_vertex_count())
-      throw Error("pick " + std::to_string(p) + " is not a vertex index (the mesh has " +
-                  std::to_string(mesh.input_vertex_count()) + " vertices)");
-    const int v = mesh.input_to_mesh(static_cast<std::size_t>(p));
-    if (v < 0) throw Error("pick " + std::to_string(p) + " is a vertex that belongs to no face; pick another vertex");
+    const int v = checked_input_vertex(mesh, p, "pick");
     if (!seen.insert(v).second)
       throw Error("pick " + std::to_string(p) + " is repeated; each picked vertex must be different");
     if (!out.empty() && mesh.component(v) != mesh.component(out.front()))

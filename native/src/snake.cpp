@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include <Eigen/Geometry>
 
-#include "grid_key.hpp"
+#include "grid.hpp"
 
 namespace relief_snake {
 
@@ -36,7 +35,11 @@ std::vector<SurfacePoint> surface_between(const Mesh& mesh, const SurfacePoint& 
   for (double t : fractions) distances.push_back(t * d);
   std::vector<SurfacePoint> out;
   if (d <= 0) return std::vector<SurfacePoint>(fractions.size(), a);
-  walk_sampled(mesh, a, pb - pa, distances, &out);
+  WalkOptions walk_options;
+  walk_options.distance = distances.empty() ? 0 : distances.back();
+  walk_options.samples = distances.data();
+  walk_options.n_samples = distances.size();
+  out = walk_points(walk(mesh, a, pb - pa, walk_options));
   // A boundary can cut the walk short: fill the rest with the last point reached.
   while (out.size() < fractions.size()) out.push_back(out.empty() ? a : out.back());
   if (nearest) {
@@ -163,6 +166,28 @@ void Snake::move(int i, const SurfacePoint& p) {
   snaxels_[i].point = p;
   snaxels_[i].position = relief_snake::position(mesh_, p);
   snaxels_[i].stamp = ++version_;
+}
+
+void Snake::take_moved_flags(std::vector<char>* moved_before) {
+  moved_before->resize(snaxels_.size());
+  for (std::size_t i = 0; i < snaxels_.size(); ++i) {
+    (*moved_before)[i] = snaxels_[i].moved;
+    snaxels_[i].moved = false;
+  }
+}
+
+void Snake::step(int i, const SurfacePoint& p) {
+  move(i, p);
+  snaxels_[i].moved = true;
+}
+
+void Snake::update_locks(int interval, double distance) {
+  for (Snaxel& s : snaxels_) {
+    if (++s.age < interval || s.locked) continue;
+    if ((s.position - s.anchor).norm() < distance) s.locked = true;
+    s.anchor = s.position;
+    s.age = 0;
+  }
 }
 
 Vec3 Snake::inward(int i) const {
@@ -334,6 +359,7 @@ int Snake::remove_loops() {
   loops_checked_ = version_;
   int removed = 0;
   std::vector<int> dirty;
+  HashGrid grid;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
     const int segments = closed_ ? n : n - 1;
@@ -356,35 +382,15 @@ int Snake::remove_loops() {
       *lo = p0.cwiseMin(p1) - Vec3::Constant(margin);
       *hi = p0.cwiseMax(p1) + Vec3::Constant(margin);
     };
-    auto cell_of = [&](int i) { return grid_cell(0.5 * (snaxels_[i].position + snaxels_[next(i)].position), cell); };
-    std::uint32_t buckets = 1;
-    while (buckets < 2u * static_cast<std::uint32_t>(segments)) buckets <<= 1;
-    auto bucket_of = [&](std::uint64_t key) {
-      return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & (buckets - 1);
-    };
-    // Counting sort of (cell, segment) entries by bucket.
-    grid_keys_.resize(segments);
-    grid_start_.assign(buckets + 1, 0);
-    for (int i = 0; i < segments; ++i) {
-      grid_keys_[i] = grid_key(cell_of(i));
-      ++grid_start_[bucket_of(grid_keys_[i]) + 1];
-    }
-    for (std::uint32_t k = 0; k < buckets; ++k) grid_start_[k + 1] += grid_start_[k];
-    grid_entries_.resize(segments);
-    {
-      std::vector<std::uint32_t> fill(grid_start_.begin(), grid_start_.end() - 1);
-      for (int i = 0; i < segments; ++i) grid_entries_[fill[bucket_of(grid_keys_[i])]++] = {grid_keys_[i], i};
-    }
+    grid.reset(snaxels_[0].position, cell);
+    auto cell_of = [&](int i) { return grid.cell_of(0.5 * (snaxels_[i].position + snaxels_[next(i)].position)); };
+    for (int i = 0; i < segments; ++i) grid.add(cell_of(i), i);
+    grid.build();
     auto for_near = [&](int d, const auto& visit) {
-      const Eigen::Array3i c = cell_of(d);
+      const HashGrid::Cell c = cell_of(d);
       for (int x = -1; x <= 1; ++x)
         for (int y = -1; y <= 1; ++y)
-          for (int z = -1; z <= 1; ++z) {
-            const std::uint64_t key = grid_key(c + Eigen::Array3i(x, y, z));
-            const std::uint32_t bucket = bucket_of(key);
-            for (std::uint32_t e = grid_start_[bucket]; e < grid_start_[bucket + 1]; ++e)
-              if (grid_entries_[e].first == key) visit(grid_entries_[e].second);
-          }
+          for (int z = -1; z <= 1; ++z) grid.for_each(c + HashGrid::Cell(x, y, z), visit);
     };
     // The crossing with the smallest first segment (then second), as a scan along the snake would find.
     int cut_a = -1, cut_b = -1;
@@ -473,33 +479,28 @@ bool Snake::within(const std::vector<Vec3>& old, double tolerance) const {
   double longest = 0;
   for (int k = 0; k < segments; ++k) longest = std::max(longest, (old[(k + 1) % m] - old[k]).norm());
   const double cell = std::max(longest, tolerance) + tolerance;
-  std::unordered_map<std::uint64_t, std::vector<int>> grid;
-  grid.reserve(static_cast<std::size_t>(segments) * 2);
+  HashGrid grid(old[0], cell);
   for (int k = 0; k < segments; ++k) {
     const Vec3 &a = old[k], &b = old[(k + 1) % m];
     const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(tolerance), hi = a.cwiseMax(b) + Vec3::Constant(tolerance);
-    const Eigen::Array3i c0 = grid_cell(lo, cell), c1 = grid_cell(hi, cell);
+    const HashGrid::Cell c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
     for (int x = c0.x(); x <= c1.x(); ++x)
       for (int y = c0.y(); y <= c1.y(); ++y)
-        for (int z = c0.z(); z <= c1.z(); ++z) grid[grid_key(Eigen::Array3i(x, y, z))].push_back(k);
+        for (int z = c0.z(); z <= c1.z(); ++z) grid.add(HashGrid::Cell(x, y, z), k);
   }
+  grid.build();
   const double t2 = tolerance * tolerance;
   for (const Snaxel& s : snaxels_) {
     const Vec3& p = s.position;
-    const auto it = grid.find(grid_key(grid_cell(p, cell)));
     bool near = false;
-    if (it != grid.end()) {
-      for (int k : it->second) {
-        const Vec3 &a = old[k], &b = old[(k + 1) % m];
-        const Vec3 ab = b - a;
-        const double len2 = ab.squaredNorm();
-        const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-        if ((a + t * ab - p).squaredNorm() <= t2) {
-          near = true;
-          break;
-        }
-      }
-    }
+    grid.for_each(grid.cell_of(p), [&](int k) {
+      if (near) return;
+      const Vec3 &a = old[k], &b = old[(k + 1) % m];
+      const Vec3 ab = b - a;
+      const double len2 = ab.squaredNorm();
+      const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+      if ((a + t * ab - p).squaredNorm() <= t2) near = true;
+    });
     if (!near) return false;
   }
   return true;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "relief_snake/plane_fit.hpp"
 #include "relief_snake/region.hpp"
 
 namespace relief_snake {
@@ -34,28 +35,16 @@ struct QuadraticBackground {
 
 QuadraticBackground fit_background(const Mesh& mesh, const std::vector<int>& samples) {
   QuadraticBackground fit;
-  double weight = 0;
-  Vec3 mean = Vec3::Zero(), normal_sum = Vec3::Zero();
-  for (const int v : samples) {
-    weight += mesh.vertex_area(v);
-    mean += mesh.vertex_area(v) * mesh.position(v);
-    normal_sum += mesh.vertex_area(v) * mesh.vertex_normal(v);
-  }
+  const VertexPlaneFit plane = fit_vertex_plane(mesh, samples);
+  const double weight = plane.weight;
   if (weight <= 0) return fit;
-  mean /= weight;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const int v : samples) {
-    const Vec3 d = mesh.position(v) - mean;
-    cov += mesh.vertex_area(v) * d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  const Vec3 mean = plane.centroid;
   fit.origin = mean;
-  fit.normal = solver.eigenvectors().col(0);
-  if (fit.normal.dot(normal_sum) < 0) fit.normal = -fit.normal;
-  fit.e1 = solver.eigenvectors().col(2);
+  fit.normal = plane.normal;
+  fit.e1 = plane.axes.col(2);
   fit.e2 = fit.normal.cross(fit.e1);
   // Scale the plane coordinates to about 1 so the normal equations are well conditioned.
-  const double scale = std::sqrt(std::max(solver.eigenvalues()[2] / weight, 1e-300));
+  const double scale = std::sqrt(std::max(plane.eigenvalues[2] / weight, 1e-300));
   fit.e1 /= scale;
   fit.e2 /= scale;
   Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();

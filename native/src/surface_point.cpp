@@ -119,20 +119,19 @@ int nearest_corner(const Mesh& mesh, const SurfacePoint& p) {
   return mesh.face_vertex(p.face, k);
 }
 
-namespace {
-
-// The walk behind every public walk. samples: increasing distances; out
-// (optional) receives, in walking order, the point at each sample distance (tag =
-// its index) and every edge crossing at a distance in [crossings_from,
-// crossings_to] (tag -1). The walk's length is the last sample distance. Plain
-// arrays, so a single-distance walk (the snake's inner loop) allocates nothing.
-Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
-               std::size_t n_samples, std::vector<WalkPoint>* out, double crossings_from = 0,
-               double crossings_to = -1) {
-  Walk result;
+WalkResult walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const WalkOptions& options) {
+  WalkResult result;
   result.end = start;
-  if (n_samples == 0 || !start.valid()) return result;
-  const double total = sample_distances[n_samples - 1];
+  if (!start.valid()) return result;
+  const double total = options.distance;
+  const double* sample_distances = options.samples;
+  const std::size_t n_samples = sample_distances ? options.n_samples : 0;
+  const bool record = n_samples > 0 || options.record_crossings;
+  std::vector<WalkPoint>* out = record ? &result.points : nullptr;
+  if (out) out->reserve(n_samples + 8);
+  // No crossing is recorded unless asked for (an empty range otherwise).
+  const double crossings_from = options.record_crossings ? options.crossings_from : 0;
+  const double crossings_to = options.record_crossings ? options.crossings_to : -1;
 
   int f = start.face;
   Vec3 b = start.bary;
@@ -150,8 +149,7 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
   int previous_face = -1;
   // Each face crossing consumes at least a tiny distance or changes face; the cap
   // guards against pathological ping-pong on degenerate geometry.
-  const int max_steps = 100000;
-  for (int step = 0; step < max_steps; ++step) {
+  for (int step = 0; step < options.max_face_steps; ++step) {
     const Vec3 db = barycentric_velocity(mesh, f, d);
     // Distance to the first corner weight reaching zero.
     double t_exit = std::numeric_limits<double>::infinity();
@@ -171,10 +169,10 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
       SurfacePoint s{f, b + t * db};
       s.bary = s.bary.cwiseMax(0.0);
       s.bary /= s.bary.sum();
-      if (out) out->push_back({s, sample_distances[next_sample], static_cast<int>(next_sample)});
+      out->push_back({s, sample_distances[next_sample], static_cast<int>(next_sample)});
       ++next_sample;
     }
-    if (next_sample == n_samples) {
+    if (total - travelled <= t_exit) {
       const double t = total - travelled;
       result.end.face = f;
       result.end.bary = (b + t * db).cwiseMax(0.0);
@@ -241,33 +239,11 @@ Walk walk_impl(const Mesh& mesh, const SurfacePoint& start, const Vec3& directio
   return result;
 }
 
-}  // namespace
-
-Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double distance) {
-  return walk_impl(mesh, start, direction, &distance, 1, nullptr);
-}
-
-namespace {
-
-void keep_points(const std::vector<WalkPoint>& traced, std::vector<SurfacePoint>* out) {
-  out->clear();
-  for (const WalkPoint& p : traced) out->push_back(p.point);
-}
-
-}  // namespace
-
-Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
-                  const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples) {
-  std::vector<WalkPoint> points;
-  const Walk w = walk_impl(mesh, start, direction, sample_distances.data(), sample_distances.size(), &points);
-  keep_points(points, samples);
-  return w;
-}
-
-Walk walk_trace(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
-                std::size_t n_samples, double crossings_from, double crossings_to, std::vector<WalkPoint>* points) {
-  points->clear();
-  return walk_impl(mesh, start, direction, sample_distances, n_samples, points, crossings_from, crossings_to);
+std::vector<SurfacePoint> walk_points(const WalkResult& walk) {
+  std::vector<SurfacePoint> out;
+  out.reserve(walk.points.size());
+  for (const WalkPoint& p : walk.points) out.push_back(p.point);
+  return out;
 }
 
 namespace {
@@ -352,15 +328,6 @@ SurfacePoint closest_point_near(const Mesh& mesh, const SurfacePoint& start, con
     if (visited.size() > 4096) break;  // a guard for absurd radii; the search is meant to be local
   }
   return best;
-}
-
-Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double from, double to,
-                  std::vector<SurfacePoint>* points) {
-  std::vector<WalkPoint> traced;
-  const double ends[2] = {from, to};
-  const Walk w = walk_trace(mesh, start, direction, ends, to > from ? 2 : 1, from, to, &traced);
-  keep_points(traced, points);
-  return w;
 }
 
 }  // namespace relief_snake

@@ -37,8 +37,6 @@ def attribute(ob, name):
 
 class ExtractionTestCase(unittest.TestCase):
     def setUp(self):
-        if cfg().get("fake"):
-            self.skipTest("the fake engine has no extraction")
         clear_scene()
         for image in list(bpy.data.images):
             bpy.data.images.remove(image)

@@ -111,7 +111,7 @@ TEST(Extract, FilesReadBackWithTheSidecarsScale) {
   const ExtractResult x = extract(mesh, truth_region(scan), scan.h);
   const fs::path dir = fresh_directory("files");
   const ExtractionFiles files = write_extraction(mesh, x, dir.string());
-  for (const std::string& name : {"background.ply", "relief.ply", "height.exr", "height.png", "height.json"})
+  for (const char* name : {"background.ply", "relief.ply", "height.exr", "height.png", "height.json"})
     EXPECT_TRUE(fs::exists(dir / name)) << name;
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find("partial"), std::string::npos) << entry.path();

@@ -52,8 +52,12 @@ TEST_P(SegmentScan, FindsTheReliefBoundary) {
   const Result result = segment(mesh, picks.vertices, options);
 
   EXPECT_EQ(result.status, Status::Converged) << result.message;
-  if (c.h_factor == 0) EXPECT_NEAR(result.parameters.step_height, scan.h, 0.25 * scan.h);
-  if (options.relief_side == ReliefSide::Auto) EXPECT_EQ(result.relief_side, picks.relief_side);
+  if (c.h_factor == 0) {
+    EXPECT_NEAR(result.parameters.step_height, scan.h, 0.25 * scan.h);
+  }
+  if (options.relief_side == ReliefSide::Auto) {
+    EXPECT_EQ(result.relief_side, picks.relief_side);
+  }
   ASSERT_GE(result.polyline.size(), 10u);
   syn::Polyline contour;
   contour.points = result.polyline;
@@ -161,8 +165,8 @@ std::vector<Case> cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Synthetic, SegmentScan, ::testing::ValuesIn(cases()),
-                         [](const ::testing::TestParamInfo<Case>& info) {
-                           std::string n = info.param.name;
+                         [](const ::testing::TestParamInfo<Case>& param_info) {
+                           std::string n = param_info.param.name;
                            for (char& ch : n)
                              if (!isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return n;

@@ -18,7 +18,7 @@ SurfacePoint point_at(const Mesh& mesh, const Vec3& target) {
     if ((mesh.position(v) - target).norm() < (mesh.position(best) - target).norm()) best = v;
   const SurfacePoint start = vertex_point(mesh, best);
   const Vec3 d = target - mesh.position(best);
-  return d.norm() > 0 ? walk(mesh, start, d, d.norm()).end : start;
+  return d.norm() > 0 ? walk(mesh, start, d, WalkOptions{d.norm()}).end : start;
 }
 
 std::vector<SurfacePoint> circle(const Mesh& mesh, Vec3 c, double r, int n, bool ccw = true) {

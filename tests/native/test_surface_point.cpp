@@ -33,7 +33,7 @@ TEST(SurfacePoint, WalkOnPlaneIsStraightAndExact) {
   const Mesh mesh = test::plane_mesh(21, 10);
   const SurfacePoint start = point_near(mesh, Vec3(2, 2, 0));
   const Vec3 dir = Vec3(1, 0.7, 0).normalized();
-  const Walk w = walk(mesh, start, dir, 5.0);
+  const WalkResult w = walk(mesh, start, dir, WalkOptions{5.0});
   EXPECT_FALSE(w.hit_boundary);
   EXPECT_NEAR(w.travelled, 5.0, 1e-9);
   EXPECT_NEAR((position(mesh, w.end) - (Vec3(2, 2, 0) + 5.0 * dir)).norm(), 0, 1e-9);
@@ -45,7 +45,7 @@ TEST(SurfacePoint, WalkThroughVerticesAlongDiagonal) {
   // Along the grid diagonal the path passes exactly through vertices.
   const Mesh mesh = test::plane_mesh(21, 10);
   const SurfacePoint start = point_near(mesh, Vec3(1, 1, 0));
-  const Walk w = walk(mesh, start, Vec3(1, 1, 0), 6.0);
+  const WalkResult w = walk(mesh, start, Vec3(1, 1, 0), WalkOptions{6.0});
   EXPECT_NEAR(w.travelled, 6.0, 1e-9);
   EXPECT_NEAR((position(mesh, w.end) - Vec3(1 + 6 / std::sqrt(2.0), 1 + 6 / std::sqrt(2.0), 0)).norm(), 0, 1e-6);
 }
@@ -53,7 +53,7 @@ TEST(SurfacePoint, WalkThroughVerticesAlongDiagonal) {
 TEST(SurfacePoint, WalkStopsAtBoundary) {
   const Mesh mesh = test::plane_mesh(11, 10);
   const SurfacePoint start = point_near(mesh, Vec3(5, 5, 0));
-  const Walk w = walk(mesh, start, Vec3(1, 0, 0), 20.0);
+  const WalkResult w = walk(mesh, start, Vec3(1, 0, 0), WalkOptions{20.0});
   EXPECT_TRUE(w.hit_boundary);
   EXPECT_NEAR(w.travelled, 5.0, 1e-9);
   EXPECT_NEAR(position(mesh, w.end).x(), 10.0, 1e-9);
@@ -68,8 +68,12 @@ TEST(SurfacePoint, WalkAcrossEdgesOnCylinderFollowsTheCircle) {
   const double arc = 6.0;
   std::vector<double> distances;
   for (int k = 1; k <= 12; ++k) distances.push_back(arc * k / 12);
-  std::vector<SurfacePoint> samples;
-  const Walk w = walk_sampled(mesh, start, Vec3(1, 0, 0), distances, &samples);
+  WalkOptions options;
+  options.distance = arc;
+  options.samples = distances.data();
+  options.n_samples = distances.size();
+  const WalkResult w = walk(mesh, start, Vec3(1, 0, 0), options);
+  const std::vector<SurfacePoint> samples = walk_points(w);
   ASSERT_EQ(samples.size(), distances.size());
   EXPECT_FALSE(w.hit_boundary);
   for (const SurfacePoint& s : samples) {
@@ -138,13 +142,22 @@ TEST(SurfacePoint, ClosestPointNearMatchesBruteForce) {
 
 TEST(SurfacePoint, WalkStretchHoldsTheExtremesOfALinearField) {
   // A per-vertex field linear inside each face takes its extremes over a stretch of a
-  // walk at the stretch's edge crossings or ends: walk_stretch() must return them all.
+  // walk at the stretch's edge crossings or ends: a walk sampling the ends and recording the
+  // crossings between them must return them all.
   const Mesh mesh = test::grid_mesh(21, 21, 10, 10, [](double u, double v) { return Vec3(u, v, 0); });
   auto field = [&](int v) { const Vec3& p = mesh.position(v); return std::sin(3 * p.x()) + std::cos(2.3 * p.y()); };
   const SurfacePoint start = point_near(mesh, Vec3(2, 3, 0));
   const Vec3 dir = Vec3(1, 0.37, 0).normalized();
-  std::vector<SurfacePoint> points;
-  const Walk w = walk_stretch(mesh, start, dir, 1.5, 4.0, &points);
+  const double ends[2] = {1.5, 4.0};
+  WalkOptions stretch;
+  stretch.distance = 4.0;
+  stretch.samples = ends;
+  stretch.n_samples = 2;
+  stretch.record_crossings = true;
+  stretch.crossings_from = 1.5;
+  stretch.crossings_to = 4.0;
+  const WalkResult w = walk(mesh, start, dir, stretch);
+  const std::vector<SurfacePoint> points = walk_points(w);
   EXPECT_FALSE(w.hit_boundary);
   ASSERT_GE(points.size(), 6u);  // the stretch crosses several edges
   double lo = 1e300, hi = -1e300;
@@ -158,12 +171,60 @@ TEST(SurfacePoint, WalkStretchHoldsTheExtremesOfALinearField) {
   }
   std::vector<double> dense;
   for (int k = 0; k <= 2000; ++k) dense.push_back(1.5 + 2.5 * k / 2000.0);
-  std::vector<SurfacePoint> samples;
-  walk_sampled(mesh, start, dir, dense, &samples);
+  WalkOptions sampled;
+  sampled.distance = dense.back();
+  sampled.samples = dense.data();
+  sampled.n_samples = dense.size();
+  const std::vector<SurfacePoint> samples = walk_points(walk(mesh, start, dir, sampled));
   ASSERT_EQ(samples.size(), dense.size());
   for (const SurfacePoint& p : samples) {
     const double f = interpolate(mesh, p, field);
     EXPECT_GE(f, lo - 1e-9);
     EXPECT_LE(f, hi + 1e-9);
   }
+}
+
+TEST(SurfacePoint, WalkRecordsSamplesAndCrossingsInWalkingOrder) {
+  // Across a grid of unit cells, slightly off the x axis: the walk crosses a vertical edge
+  // about every unit (and diagonals in between). Samples carry their index, crossings tag -1,
+  // all in order of distance, crossings only inside the range asked for.
+  const Mesh mesh = test::grid_mesh(11, 11, 10, 10, [](double u, double v) { return Vec3(u, v, 0); });
+  const SurfacePoint start = point_near(mesh, Vec3(1, 5, 0));
+  const Vec3 from = position(mesh, start);
+  const Vec3 dir = Vec3(1, 0.13, 0).normalized();
+  // Leaving the start vertex, the walk nudges its crossing 1e-9 (barycentric) off the corner.
+  const double tol = 1e-8;
+  const double samples[3] = {0.5, 2.0, 3.5};
+  WalkOptions options;
+  options.distance = 4.0;
+  options.samples = samples;
+  options.n_samples = 3;
+  const WalkResult plain = walk(mesh, start, dir, options);
+  ASSERT_EQ(plain.points.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(plain.points[k].tag, k);
+    EXPECT_NEAR((position(mesh, plain.points[k].point) - (from + samples[k] * dir)).norm(), 0, tol);
+  }
+  options.record_crossings = true;
+  options.crossings_from = 1.0;
+  options.crossings_to = 3.0;
+  const WalkResult traced = walk(mesh, start, dir, options);
+  int crossings = 0;
+  double last = -1;
+  for (const WalkPoint& p : traced.points) {
+    EXPECT_GE(p.distance, last);
+    last = p.distance;
+    if (p.tag >= 0) continue;
+    ++crossings;
+    EXPECT_GE(p.distance, 1.0 - 1e-12);
+    EXPECT_LE(p.distance, 3.0 + 1e-12);
+    EXPECT_NEAR((position(mesh, p.point) - (from + p.distance * dir)).norm(), 0, tol);
+  }
+  EXPECT_GE(crossings, 2);  // at least the vertical edges x = 3 and x = 4
+  EXPECT_EQ(static_cast<int>(traced.points.size()) - crossings, 3);
+  // Nothing asked for, nothing recorded; the end is the same.
+  const WalkResult bare = walk(mesh, start, dir, WalkOptions{4.0});
+  EXPECT_TRUE(bare.points.empty());
+  EXPECT_EQ(bare.end.face, traced.end.face);
+  EXPECT_NEAR((position(mesh, bare.end) - (from + 4.0 * dir)).norm(), 0, tol);
 }

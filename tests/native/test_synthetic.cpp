@@ -578,7 +578,9 @@ TEST(SyntheticRandom, DrawsStayInTheirRanges) {
     ASSERT_LE(d.typed_factor, 2.0);
     ASSERT_LE(d.spec.noise, 0.05);
     ASSERT_LE(std::abs(d.spec.texture_amplitude), 0.3);
-    if (d.spec.step == Step::Blended) ASSERT_LE(d.spec.blend_width, 1.0);
+    if (d.spec.step == Step::Blended) {
+      ASSERT_LE(d.spec.blend_width, 1.0);
+    }
     ++shapes[d.axes["shape"].get<std::string>()];
     ++backgrounds[d.axes["background"].get<std::string>()];
     ++textures[d.axes["texture"].get<std::string>()];
@@ -615,7 +617,9 @@ TEST(SyntheticRandom, ScansAreConsistentWithTheirTruth) {
       const Vec3 expected = s.surface(u, w, 0) +
                             (s.relief_height[v] + s.texture_height[v] + s.noise_height[v]) * s.background_normal(u, w);
       ASSERT_LT((s.vertex(v) - expected).norm(), 1e-9 * (1 + s.h)) << "vertex " << v;
-      if (!s.relief[v]) ASSERT_EQ(s.relief_height[v], 0.0);
+      if (!s.relief[v]) {
+        ASSERT_EQ(s.relief_height[v], 0.0);
+      }
     }
     const IouFloor floor = one_edge_floor(s);
     EXPECT_GT(floor.area, 0.5);
@@ -659,8 +663,11 @@ TEST(SyntheticRandom, TexturesStayWithinTheirAmplitudeOffTheRelief) {
     EXPECT_LE(hi, 0.25 + 1e-12);
     EXPECT_GT(hi, 0.2);  // the texture is there
     // Sharp step: no texture on the relief's top.
-    for (std::size_t v = 0; v < s.n_vertices(); ++v)
-      if (s.relief[v]) ASSERT_EQ(s.texture_height[v], 0.0);
+    for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+      if (s.relief[v]) {
+        ASSERT_EQ(s.texture_height[v], 0.0);
+      }
+    }
   }
 }
 

@@ -4,6 +4,7 @@
 // checks and prints them the same way. A new advanced option is one row in
 // option_table.cpp.
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "relief_snake/segment.hpp"
@@ -25,6 +26,18 @@ const std::vector<OptionInfo>& advanced_options();
 
 /// "tau, epsilon, ...": the names, for messages.
 std::string advanced_option_names();
+
+/// An advanced option's value: bool (Boolean), long long (Integer), double (Number) or the
+/// choice's name (Choice).
+using OptionValue = std::variant<bool, long long, double, std::string>;
+
+/// Sets option `name` from a typed value (the module's keyword arguments): a Number takes a
+/// double or a long long, the other types exactly their own alternative. Throws Error like the
+/// text form for a value of the wrong type or out of range.
+void set_advanced_option_value(Options* options, const std::string& name, const OptionValue& value);
+
+/// The value of option `name`.
+OptionValue advanced_option_value(const Options& options, const std::string& name);
 
 /// Sets option `name` from its text form ("0.25", "1", "true", "euclidean").
 /// Throws Error with one line naming the option, the accepted values and what was given,

@@ -4,6 +4,8 @@
 // (the paper: the neighbouring vertices, unit weight each) or of triangles (the
 // surface area of the neighbourhood, so the fit does not depend on how densely
 // the scanner sampled each part of it).
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "relief_snake/mesh.hpp"
@@ -33,5 +35,23 @@ struct PlaneMoments {
 /// Degenerate sets: 0 for no weight or all points coincident; the surface normal as
 /// n when the points are collinear.
 double planarity_about_vertex(const PlaneMoments& moments_about_v, const Vec3& vertex_normal);
+
+/// The least-squares plane of some mesh vertices, each weighted by its area (Mesh::vertex_area)
+/// or by 1: fitted in two passes (the weighted centroid, then the covariance about it), so it
+/// stays exact far from the origin. Used where the vertices are few and listed (the self-check's
+/// local backgrounds, the step-height estimate, the extraction's ring); the planarity field's
+/// many overlapping neighbourhoods sum PlaneMoments instead.
+struct VertexPlaneFit {
+  double weight = 0;                    ///< total weight; 0: no vertices (nothing else is set)
+  Vec3 centroid = Vec3::Zero();         ///< weighted mean position
+  Vec3 normal = Vec3::UnitZ();          ///< the least axis, oriented like the weighted vertex normals
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< covariance eigenvectors, columns by increasing eigenvalue
+  Vec3 eigenvalues = Vec3::Zero();      ///< of the weighted covariance sum(w d d^T), increasing
+  /// RMS distance of the vertices from the plane (weighted).
+  double residual() const;
+};
+
+/// `vertices` #N mesh vertex indices (repeats count twice).
+VertexPlaneFit fit_vertex_plane(const Mesh& mesh, const std::vector<int>& vertices, bool area_weighted = true);
 
 }  // namespace relief_snake

@@ -30,15 +30,27 @@ class Snake {
   int size() const { return static_cast<int>(snaxels_.size()); }
   bool closed() const { return closed_; }
   bool inside_left() const { return inside_left_; }
-  Snaxel& operator[](int i) { return snaxels_[i]; }
+  /// Read-only: snaxels change only through the calls below, which keep the change stamps
+  /// housekeeping relies on.
   const Snaxel& operator[](int i) const { return snaxels_[i]; }
   /// Neighbour indices; -1 past the ends of an open snake.
   int prev(int i) const { return i > 0 ? i - 1 : (closed_ ? size() - 1 : -1); }
   int next(int i) const { return i + 1 < size() ? i + 1 : (closed_ ? 0 : -1); }
   bool is_end(int i) const { return !closed_ && (i == 0 || i == size() - 1); }
 
-  /// Moves snaxel i to p.
+  /// Moves snaxel i to p (stamped as changed; its moved flag is left as it is).
   void move(int i, const SurfacePoint& p);
+
+  // The greedy evolution's interface (evolution.cpp): the moved flags and the oscillation lock.
+  /// Starts a greedy iteration: (*moved_before)[i] = snaxel i's moved flag, and every flag cleared.
+  void take_moved_flags(std::vector<char>* moved_before);
+  /// A greedy move: move(i, p), and i flagged as moved (the next iteration looks at it and its
+  /// neighbours again).
+  void step(int i, const SurfacePoint& p);
+  /// The oscillation lock (Section 6.1), after each iteration: every `interval` iterations of its
+  /// own, a snaxel that got less than `distance` from where it was at its last check is frozen for
+  /// the phase (reset_state() thaws it).
+  void update_locks(int interval, double distance);
   /// Unit direction towards the inside (relief side) at snaxel i, in the tangent
   /// plane: along the bisector of its two segments.
   Vec3 inward(int i) const;
@@ -94,10 +106,6 @@ class Snake {
   std::uint64_t version_ = 0;  // changes so far (stamps)
   std::uint64_t turns_checked_ = 0, spacing_checked_ = 0, loops_checked_ = 0;  // version_ when each last looked
   double spacing_l_ = -1;      // the l of the last resample()
-  // remove_loops() buffers: a hash grid of segment boxes, reused between calls.
-  std::vector<std::uint32_t> grid_start_;
-  std::vector<std::uint64_t> grid_keys_;
-  std::vector<std::pair<std::uint64_t, int>> grid_entries_;
 };
 
 /// Points on the surface between a and b at fractions t_k of their distance: the

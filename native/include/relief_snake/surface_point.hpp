@@ -36,45 +36,50 @@ bool common_face(const Mesh& mesh, const SurfacePoint& a, const SurfacePoint& b,
 /// The mesh vertex nearest to p among its face's corners.
 int nearest_corner(const Mesh& mesh, const SurfacePoint& p);
 
-/// Where a straight walk on the surface ended.
-struct Walk {
-  SurfacePoint end;
-  double travelled = 0;    ///< surface distance covered (< requested if a boundary stopped it)
-  bool hit_boundary = false;
-  Vec3 direction = Vec3::Zero();  ///< unit walking direction at the end (in the end face's plane)
-  int boundary_face = -1, boundary_edge = -1;  ///< the boundary edge that stopped the walk (face, opposite corner)
-};
-
 /// A point a walk passed, with its distance along the walk.
 struct WalkPoint {
   SurfacePoint point;
   double distance = 0;
-  int tag = -1;  ///< walk_trace(): the index of the sample distance, or -1 for an edge crossing
+  int tag = -1;  ///< the index of the sample distance (WalkOptions::samples), or -1 for an edge crossing
 };
 
-/// Walks from `start` along `direction` (projected into the start face's plane)
-/// for `distance`, crossing edges by unfolding the direction about them, so the
-/// path is a straightest line on the surface. Stops at a mesh boundary.
-Walk walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double distance);
+/// What a walk records and where it stops.
+struct WalkOptions {
+  /// How far to walk along the surface; a mesh boundary stops it sooner.
+  double distance = 0;
+  /// Record the point reached at each of these increasing distances (<= distance), tagged with its
+  /// index; samples beyond a boundary are not reached. The caller's array (`n_samples` values), so a
+  /// walk that records nothing allocates nothing (the snake's inner loop).
+  const double* samples = nullptr;
+  std::size_t n_samples = 0;
+  /// Record every edge crossing at a distance in [crossings_from, crossings_to] (tag -1).
+  bool record_crossings = false;
+  double crossings_from = 0, crossings_to = 0;
+  /// A guard against ping-pong on degenerate geometry: faces crossed at most.
+  int max_face_steps = 100000;
+};
 
-/// The same walk, also recording the point reached at each of the increasing
-/// `sample_distances` (those beyond a boundary are not reached). Returns the walk;
-/// samples->size() is the number of sample points reached.
-Walk walk_sampled(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction,
-                  const std::vector<double>& sample_distances, std::vector<SurfacePoint>* samples);
+/// Where a straight walk on the surface ended, and what it recorded.
+struct WalkResult {
+  SurfacePoint end;
+  double travelled = 0;    ///< surface distance covered (< WalkOptions::distance if a boundary stopped it)
+  bool hit_boundary = false;
+  Vec3 direction = Vec3::Zero();  ///< unit walking direction at the end (in the end face's plane)
+  int boundary_face = -1, boundary_edge = -1;  ///< the boundary edge that stopped the walk (face, opposite corner)
+  /// In walking order: the samples reached and the edge crossings asked for (WalkOptions).
+  std::vector<WalkPoint> points;
+};
 
-/// The same walk, for sample_distances[n_samples - 1], recording in walking order
-/// the point at each (increasing) sample distance and every edge crossing at a
-/// distance in [crossings_from, crossings_to] (none if crossings_to < crossings_from).
-Walk walk_trace(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const double* sample_distances,
-                std::size_t n_samples, double crossings_from, double crossings_to, std::vector<WalkPoint>* points);
+/// Walks from `start` along `direction` (projected into the start face's plane) for
+/// options.distance, crossing edges by unfolding the direction about them, so the path is a
+/// straightest line on the surface. Stops at a mesh boundary. A per-vertex value interpolated
+/// linearly in each face takes its extremes over a stretch of the walk at the stretch's ends and
+/// edge crossings: sample the ends and record the crossings between them. The plain walk is
+/// `walk(mesh, start, direction, WalkOptions{distance})`.
+WalkResult walk(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, const WalkOptions& options);
 
-/// The same walk from distance `from` to `to` (0 <= from <= to): *points gets every
-/// edge crossing in that stretch and its two ends (those reached before a boundary),
-/// in no particular order. A per-vertex value interpolated linearly in each face
-/// takes its extremes over the stretch at these points.
-Walk walk_stretch(const Mesh& mesh, const SurfacePoint& start, const Vec3& direction, double from, double to,
-                  std::vector<SurfacePoint>* points);
+/// The surface points of a walk's recorded points, in walking order.
+std::vector<SurfacePoint> walk_points(const WalkResult& walk);
 
 /// The point of the surface nearest to `target`, searched among the faces reachable
 /// from start's face through faces that come within `radius` of the target (so
