@@ -13,6 +13,7 @@
 
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
+#include "plate_scans.hpp"
 #include "synthetic.hpp"
 
 namespace rs = relief_snake;
@@ -162,7 +163,7 @@ int run_random(std::uint64_t seed, const std::string& out) {
 int run(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::cout << kUsage;
+    std::cout << kUsage << syn::kPlateUsage;
     return args.empty() ? 2 : 0;
   }
   if (args[0] == "score") {
@@ -170,6 +171,7 @@ int run(int argc, char** argv) {
     if (args.size() != 3) throw rs::Error("score needs two files: make-scan score TRUTH.json RESULT.json [--mesh MESH]");
     return run_score(args[1], args[2], "");
   }
+  if (args[0] == "--plate") return syn::run_plate_command(args);
   if (args[0] == "--random") {
     if (args.size() != 4 || args[2] != "--out")
       throw rs::Error("--random needs a seed and an output prefix: make-scan --random SEED --out PREFIX");
