@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "extract_command.hpp"
+#include "multi_command.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/option_table.hpp"
 #include "relief_snake/result_json.hpp"
@@ -38,6 +39,7 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  relief-snake segment MESH --picks I,J,K,... [--step-height H|auto] [options]\n"
+    "  relief-snake detect MESH [--region-vertices FILE] [--min-area A] [--out FILE] [options]\n"
     "  relief-snake measure MESH I J\n"
     "  relief-snake info MESH\n"
     "  relief-snake extract MESH RESULT.json --out DIR [options]\n"
@@ -49,7 +51,9 @@ const char* kUsage =
     "                         file, skipping invalid faces and vertices; what was skipped is reported\n"
     "\n"
     "segment: find the outline of the relief around (or beside) the picked vertices.\n"
-    "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open)\n"
+    "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open);\n"
+    "                         repeat it for several reliefs: one snake each, written as one document\n"
+    "                         with a result per relief and their overlaps (docs/result-format.md)\n"
     "  --step-height H|auto   the relief's step height, in mesh units (> 0; see 'measure'); auto (the\n"
     "                         default): estimated from the picks and the surface\n"
     "  --w-int W|auto         internal-energy weight for refinement, in (0, 1]; auto (the default):\n"
@@ -219,6 +223,7 @@ int run_measure(const std::vector<std::string>& args) {
 struct SegmentArgs {
   std::string mesh_path, out_path;
   std::vector<std::int64_t> picks;
+  std::vector<std::vector<std::int64_t>> groups;  ///< every --picks, in order (picks: the first)
   rs::Options options;
   bool have_picks = false, have_height = false, have_side = false, quiet = false;
 };
@@ -246,7 +251,8 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       if (inline_value) throw UsageError(name + " takes no value");
     };
     if (name == "--picks") {
-      a.picks = parse_picks(take_value());
+      a.groups.push_back(parse_picks(take_value()));
+      a.picks = a.groups.front();
       a.have_picks = true;
     } else if (name == "--step-height") {
       const std::string value = take_value();
@@ -298,8 +304,9 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
   if (!a.have_picks) throw UsageError("segment needs --picks I,J,K,... (0-based vertex indices around the relief)");
   if (a.have_side && a.options.closed) throw UsageError("--relief-side only applies with --open");
   const std::size_t min_picks = a.options.closed ? 3 : 2;
-  if (a.picks.size() < min_picks)
-    throw UsageError(std::string("--picks needs at least ") + std::to_string(min_picks) + " vertices for " +
+  for (const auto& group : a.groups)
+    if (group.size() < min_picks)
+      throw UsageError(std::string("--picks needs at least ") + std::to_string(min_picks) + " vertices for " +
                      (a.options.closed ? "a closed" : "an open") + " contour");
   return a;
 }
@@ -308,10 +315,14 @@ int run_segment(const std::vector<std::string>& args) {
   const SegmentArgs a = parse_segment(args);
   double load_seconds = 0;
   const rs::Mesh mesh = load_mesh(a.mesh_path, &load_seconds);
-  for (const std::int64_t p : a.picks) check_vertex(mesh, p, "pick");
+  for (const auto& group : a.groups)
+    for (const std::int64_t p : group) check_vertex(mesh, p, "pick");
   if (!a.quiet)
     std::fprintf(stderr, "relief-snake: loaded %s in %.2f s: %s\n", a.mesh_path.c_str(), load_seconds,
                  mesh.report().summary().c_str());
+
+  if (a.groups.size() > 1)
+    return rs::cli::run_segment_groups(mesh, a.groups, a.options, a.mesh_path, a.out_path, load_seconds, a.quiet);
 
   // Progress: at phase changes and every 25 iterations.
   std::string last_phase;
@@ -379,7 +390,8 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
-    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + advanced_options_help();
+    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + rs::cli::kDetectUsage + "\n" +
+                             advanced_options_help();
     const std::string command = args[0];
     if (command == "--help" || command == "-h" || command == "help") {
       std::cout << help;
@@ -397,9 +409,16 @@ int main(int argc, char** argv) {
       }
     if (command == "segment") return rs::cli::run_segment_with_extract(rest, run_segment);
     if (command == "extract") return rs::cli::run_extract(rest);
+    if (command == "detect") {
+      try {
+        return rs::cli::run_detect(rest, load_mesh);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
     if (command == "measure") return run_measure(rest);
     if (command == "info") return run_info(rest);
-    throw UsageError("unknown command '" + command + "'; use segment, measure, info or extract (see relief-snake --help)");
+    throw UsageError("unknown command '" + command + "'; use segment, detect, measure, info or extract (see relief-snake --help)");
   } catch (const UsageError& e) {
     return fail(e.what(), 2);
   } catch (const rs::Error& e) {
