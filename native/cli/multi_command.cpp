@@ -216,6 +216,10 @@ int run_detect(const std::vector<std::string>& args, const MeshLoader& load) {
   const std::vector<std::int64_t> region = region_path.empty() ? std::vector<std::int64_t>{} : read_indices(region_path);
   double load_seconds = 0;
   const Mesh mesh = load(mesh_path, &load_seconds);
+  for (const std::int64_t v : region)  // bad input is one line, before any progress
+    if (static_cast<std::size_t>(v) >= mesh.input_vertex_count())
+      throw Error(region_path + ": region vertex " + std::to_string(v) + " is out of range: the mesh file has " +
+                  std::to_string(mesh.input_vertex_count()) + " vertices (indices are 0-based)");
   if (!quiet)
     std::fprintf(stderr, "relief-snake: loaded %s in %.2f s: %s\n", mesh_path.c_str(), load_seconds,
                  mesh.report().summary().c_str());

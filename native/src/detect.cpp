@@ -373,7 +373,10 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
             cand.refined = std::move(attempt);
             cand.score = score;
           }
-          if (cand.refined.ok && cand.refined.result.status == Status::Converged) break;
+          // A doubtful result that still agrees with the component (the low one of two touching
+          // reliefs: the step along their shared side goes up, not down) is not improved by a larger h.
+          if (cand.refined.ok && (cand.refined.result.status == Status::Converged || cand.score >= options.retry_below))
+            break;
         }
       }
       if (out.cancelled) break;

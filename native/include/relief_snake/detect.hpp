@@ -45,6 +45,7 @@ struct DetectOptions {
   /// h tried in turn (times the candidate's median height) until the self-check holds, keeping
   /// the best score; only when segment.step_height is kAuto.
   std::vector<double> retry_factors = {1.0, 1.3, 1.7};
+  double retry_below = 0.6;       ///< ... and only while the score stays below this
   double duplicate_iou = 0.5;     ///< refined regions overlapping more than this are one relief
   /// The snake's options. step_height kAuto (default): each candidate's median height.
   Options segment;
