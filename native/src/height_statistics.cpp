@@ -5,24 +5,45 @@
 #include <algorithm>
 #include <cmath>
 
+#include "relief_snake/error.hpp"
+
 namespace relief_snake {
+
+namespace {
+/// Degree 6 at most: 28 monomials.
+constexpr int kMaxTerms = 28;
+
+/// The monomials 1, x, y, x^2, xy, y^2, ... of total degree <= degree into out (no allocation:
+/// the robust fit evaluates them for every vertex in every round).
+void monomials(int degree, double x, double y, double* out) {
+  double xp[8], yp[8];
+  xp[0] = yp[0] = 1;
+  for (int k = 1; k <= degree; ++k) xp[k] = xp[k - 1] * x, yp[k] = yp[k - 1] * y;
+  int k = 0;
+  for (int total = 0; total <= degree; ++total)
+    for (int px = total; px >= 0; --px) out[k++] = xp[px] * yp[total - px];
+}
+}  // namespace
 
 Eigen::VectorXd PolynomialBackground::basis(int degree, double x, double y) {
   Eigen::VectorXd b((degree + 1) * (degree + 2) / 2);
-  int k = 0;
-  for (int total = 0; total <= degree; ++total)
-    for (int px = total; px >= 0; --px) b[k++] = std::pow(x, px) * std::pow(y, total - px);
+  monomials(degree, x, y, b.data());
   return b;
 }
 
 double PolynomialBackground::height(const Vec3& p) const {
   const Vec3 d = p - origin;
   if (c.size() == 0) return d.dot(normal);
-  return d.dot(normal) - basis(degree, d.dot(e1), d.dot(e2)).dot(c);
+  double phi[kMaxTerms];
+  monomials(degree, d.dot(e1), d.dot(e2), phi);
+  double sum = 0;
+  for (int k = 0; k < c.size(); ++k) sum += phi[k] * c[k];
+  return d.dot(normal) - sum;
 }
 
 PolynomialBackground fit_polynomial_background(const Mesh& mesh, const std::vector<int>& samples, int degree,
                                                const std::vector<double>* weights) {
+  if (degree < 0 || degree > 6) throw Error("the background polynomial's degree must be between 0 and 6");
   PolynomialBackground fit;
   fit.degree = degree;
   const int terms = (degree + 1) * (degree + 2) / 2;
@@ -55,13 +76,18 @@ PolynomialBackground fit_polynomial_background(const Mesh& mesh, const std::vect
   fit.e2 /= scale;
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(terms, terms);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(terms);
+  double phi[kMaxTerms];
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const double w = weight_of(i);
     if (w <= 0) continue;
     const Vec3 d = mesh.position(samples[i]) - mean;
-    const Eigen::VectorXd phi = PolynomialBackground::basis(degree, d.dot(fit.e1), d.dot(fit.e2));
-    A.selfadjointView<Eigen::Lower>().rankUpdate(phi, w);
-    b += w * d.dot(fit.normal) * phi;
+    monomials(degree, d.dot(fit.e1), d.dot(fit.e2), phi);
+    const double z = w * d.dot(fit.normal);
+    for (int r = 0; r < terms; ++r) {
+      const double wr = w * phi[r];
+      for (int col = 0; col <= r; ++col) A(r, col) += wr * phi[col];
+      b[r] += z * phi[r];
+    }
   }
   A = A.selfadjointView<Eigen::Lower>();
   fit.c = A.ldlt().solve(b);
@@ -99,7 +125,7 @@ RobustFit fit_robust_background(const Mesh& mesh, const std::vector<int>& sample
     out.inlier_share = total > 0 ? inliers / total : 0;
     out.background = fit_polynomial_background(mesh, samples, options.degree, &weights);
     out.iterations = round + 1;
-    if (change < 1e-3) break;
+    if (change < 1e-2) break;  // no weight moved by more than 1%
   }
   return out;
 }
