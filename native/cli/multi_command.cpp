@@ -30,7 +30,8 @@ const char* kDetectUsage =
     "  --min-area A            smallest relief area kept, in mesh units squared (default (12 average\n"
     "                          edges)^2, about a disk 13 edges across)\n"
     "  --step-height H         refine every candidate with this h (default: each candidate's own height)\n"
-    "  --background-degree D   degree of the background polynomial, 0..6 (default 4)\n"
+    "  --background-degree D   degree of the background polynomial, 0..6, or auto (the default: the lowest\n"
+    "                          of 2, 4, 6 that fits about as well as the best)\n"
     "  --no-refine             only the thresholded components (no snake): fast, rough outlines\n"
     "  --option NAME=VALUE     an advanced option of the snake (as for segment)\n"
     "  --out FILE              write the JSON document to FILE instead of stdout\n"
@@ -180,9 +181,14 @@ int run_detect(const std::vector<std::string>& args, const MeshLoader& load) {
       options.segment.step_height = v == "auto" ? kAuto : number(v, "--step-height");
       if (v != "auto" && !(options.segment.step_height > 0)) throw std::invalid_argument("--step-height must be > 0 or auto");
     } else if (name == "--background-degree") {
-      const double d = number(take(), "--background-degree");
-      if (d != std::floor(d) || d < 0 || d > 6) throw std::invalid_argument("--background-degree must be 0..6");
-      options.background_degree = static_cast<int>(d);
+      const std::string v = take();
+      if (v == "auto") {
+        options.background_degree = kAutoDegree;
+      } else {
+        const double d = number(v, "--background-degree");
+        if (d != std::floor(d) || d < 0 || d > 6) throw std::invalid_argument("--background-degree must be 0..6 or auto");
+        options.background_degree = static_cast<int>(d);
+      }
     } else if (name == "--no-refine") {
       if (inline_value) throw std::invalid_argument("--no-refine takes no value");
       options.refine = false;

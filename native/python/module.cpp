@@ -666,7 +666,7 @@ class PyMesh {
   }
 
   py::dict detect(py::object region_vertices, py::object min_area, py::object step_height, bool refine,
-                  int background_degree, py::object w_int, int max_iterations, py::object progress,
+                  py::object background_degree, py::object w_int, int max_iterations, py::object progress,
                   const py::kwargs& advanced) {
     check_not_running(*segmenter_, "detect");
     DetectOptions options;
@@ -680,7 +680,14 @@ class PyMesh {
         throw Error("min_area must be a finite number > 0 (mesh units squared), or None for the default");
     }
     options.refine = refine;
-    options.background_degree = background_degree;
+    if (!background_degree.is_none()) {
+      if (PyBool_Check(background_degree.ptr()) || !PyLong_Check(background_degree.ptr()))
+        throw py::type_error("background_degree must be an int 0..6 or None (auto), got " +
+                             std::string(py::str(py::repr(background_degree))));
+      options.background_degree = background_degree.cast<int>();
+      if (options.background_degree < 0 || options.background_degree > 6)
+        throw Error("background_degree must be between 0 and 6 (2: a quadric), or None to choose it");
+    }
     std::vector<std::int64_t> region;
     if (!region_vertices.is_none()) {
       region = read_array<std::int64_t>(region_vertices, Kind::Int, "region_vertices", false);
@@ -871,9 +878,9 @@ PYBIND11_MODULE(relief_snake_core, m) {
            "snaxels, contour) -> bool|None, index: the group being segmented; False raises Cancelled.")
       .def("detect", &PyMesh::detect, py::arg("region_vertices") = py::none(), py::kw_only(),
            py::arg("min_area") = py::none(), py::arg("step_height") = py::none(), py::arg("refine") = true,
-           py::arg("background_degree") = 4, py::arg("w_int") = "auto", py::arg("max_iterations") = 3000,
+           py::arg("background_degree") = py::none(), py::arg("w_int") = "auto", py::arg("max_iterations") = 3000,
            py::arg("progress") = py::none(),
-           "detect(region_vertices=None, *, min_area=None, step_height=None, refine=True, background_degree=4,\n"
+           "detect(region_vertices=None, *, min_area=None, step_height=None, refine=True, background_degree=None,\n"
            "       w_int='auto', max_iterations=3000, progress=None, **advanced) -> dict\n\n"
            "Proposes the reliefs of the region (vertex indices; None: the whole mesh) without picks: a robust\n"
            "background fit, Otsu's threshold, components of at least min_area (mesh units squared; None:\n"

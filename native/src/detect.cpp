@@ -33,8 +33,8 @@ constexpr int kOpeningRings = 3;
 void validate(const DetectOptions& o) {
   if (!(o.min_area >= 0) || !std::isfinite(o.min_area))
     throw Error("min_area must be a number >= 0 in mesh units squared (0: the default, (12 average edges)^2)");
-  if (o.background_degree < 0 || o.background_degree > 6)
-    throw Error("background_degree must be between 0 and 6 (2: a quadric, 4: the default)");
+  if (o.background_degree != kAutoDegree && (o.background_degree < 0 || o.background_degree > 6))
+    throw Error("background_degree must be between 0 and 6 (2: a quadric), or auto");
   if (o.robust_iterations < 0 || o.robust_iterations > 100) throw Error("robust_iterations must be between 0 and 100");
   if (o.histogram_bins < 8 || o.histogram_bins > 65536) throw Error("histogram_bins must be between 8 and 65536");
   if (!(o.min_height_sigmas >= 0) || !std::isfinite(o.min_height_sigmas)) throw Error("min_height_sigmas must be >= 0");
@@ -208,18 +208,37 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
   std::vector<int> samples;
   for (int v = 0; v < nv; ++v)
     if (in_region[v]) samples.push_back(v);
-  const int terms = (options.background_degree + 1) * (options.background_degree + 2) / 2;
+  const int max_degree = options.background_degree == kAutoDegree ? 6 : options.background_degree;
+  const int terms = (max_degree + 1) * (max_degree + 2) / 2;
   if (static_cast<int>(samples.size()) < 4 * terms + 10)
     throw Error("the region has " + std::to_string(samples.size()) +
                 " vertices on the surface, too few to fit a background; give a larger region");
   out.background.region_vertices = samples.size();
-  out.background.degree = options.background_degree;
 
   // --- 1. robust background over the whole region --------------------------------------
+  // auto: the lowest degree of 2, 4, 6 whose noise sigma is within 10% of the best (a plane or a
+  // gentle curve keeps its quadric; a vase's changing radius needs the sixth degree).
   RobustFitOptions fit_options;
-  fit_options.degree = options.background_degree;
   fit_options.iterations = options.robust_iterations;
-  const RobustFit fit = fit_robust_background(mesh, samples, fit_options);
+  RobustFit fit;
+  if (options.background_degree != kAutoDegree) {
+    fit_options.degree = options.background_degree;
+    fit = fit_robust_background(mesh, samples, fit_options);
+  } else {
+    std::vector<RobustFit> fits;
+    for (const int degree : {2, 4, 6}) {
+      fit_options.degree = degree;
+      fits.push_back(fit_robust_background(mesh, samples, fit_options));
+    }
+    double best = fits[0].sigma;
+    for (const RobustFit& f : fits) best = std::min(best, f.sigma);
+    for (const RobustFit& f : fits)
+      if (f.sigma <= 1.1 * best + 1e-12 * mesh.bbox_diagonal()) {
+        fit = f;
+        break;
+      }
+  }
+  out.background.degree = fit.background.degree;
   std::vector<double> height(nv, 0);
   std::vector<WeightedHeight> values;
   values.reserve(samples.size());

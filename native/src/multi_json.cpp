@@ -109,7 +109,8 @@ json detect_json(const DetectResult& result, const DetectOptions& options, const
               {"parameters",
                {{"min_area", options.min_area > 0 ? options.min_area : std::pow(12 * edge, 2)},
                 {"min_area_given", options.min_area > 0},
-                {"background_degree", options.background_degree},
+                {"background_degree", options.background_degree == kAutoDegree ? nlohmann::json("auto")
+                                                                                 : nlohmann::json(options.background_degree)},
                 {"min_height_sigmas", options.min_height_sigmas},
                 {"refine", options.refine},
                 {"outline_offset", options.outline_offset},

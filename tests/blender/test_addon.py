@@ -742,7 +742,10 @@ class SeveralReliefs(AddonTestCase):
 
     def test_pick_group_errors(self):
         obj = self._plate_object()
-        self.assertEqual(bpy.ops.mesh.relief_snake_segment_groups(prefix="Picks"), {'CANCELLED'})
+        before = snapshot()
+        with self.assertRaisesRegex(RuntimeError, "No vertex group of 'Plate' starts with 'Picks'"):
+            bpy.ops.mesh.relief_snake_segment_groups(prefix="Picks")
+        self.assertEqual(snapshot(), before)
         g = obj.vertex_groups.new(name="Picks1")
         g.add([0, 1], 1.0, 'REPLACE')
         with self.assertRaisesRegex(addon().job.EngineError, "at least 3"):

@@ -27,11 +27,16 @@
 
 namespace relief_snake {
 
+/// DetectOptions::background_degree: chosen by the fit.
+constexpr int kAutoDegree = -1;
+
 struct DetectOptions {
   /// Smallest relief area kept, in mesh units squared; 0 (the default): (12 average edges)^2, the
   /// smallest outline the snake resolves comfortably (a disk about 13 edges across).
   double min_area = 0;
-  int background_degree = 4;      ///< total degree of the background polynomial (2: a quadric)
+  /// Total degree of the background polynomial (2: a quadric), or kAutoDegree: 2, 4 and 6 are
+  /// fitted and the lowest degree whose robust noise sigma is within 10% of the best is kept.
+  int background_degree = -1;
   int robust_iterations = 12;     ///< reweighting rounds at most
   int histogram_bins = 256;
   double min_height_sigmas = 5;   ///< the threshold is at least this many robust noise sigmas above the fit
