@@ -274,7 +274,10 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
     if (above < min_area || weighted_quantile(upper, 0.5) < 1.6 * split.threshold) break;
     threshold = split.threshold;
   }
-  threshold = std::max(threshold, floor);
+  // Otsu's level separates background and relief, but it may cut through the lowest relief's top
+  // (noise spreads it across the level): candidates are taken halfway down, so that top stays
+  // whole; the snake finds the outline anyway.
+  threshold = std::max(0.5 * threshold, floor);
   out.background.threshold = threshold;
 
   // --- 3. components, split into plateaus ------------------------------------------------

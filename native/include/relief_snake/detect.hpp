@@ -6,7 +6,8 @@
 //    height_statistics.hpp): reliefs stand clearly above it and end with weight 0.
 // 2. Threshold: Otsu's split of the area-weighted height histogram; while the lower class itself
 //    splits into background and a lower relief level standing clear of the noise, the threshold
-//    moves down to that split (so a low relief beside a tall one is not lost). Never below
+//    moves down to that split (so a low relief beside a tall one is not lost). Candidates are
+//    taken at half that level (a noisy low relief's top straddles it), never below
 //    min_height_sigmas robust noise sigmas.
 // 3. Candidates: connected components above the threshold of at least min_area. A component
 //    whose heights fall into two clearly separate plateaus (reliefs of different heights that
