@@ -74,6 +74,7 @@ def main():
                        % (os.path.basename(args.mesh), len(written), doc["timing"]["detect_seconds"]))
     name = os.path.splitext(os.path.basename(args.mesh))[0]
     png = os.path.abspath(os.path.join(args.out, name + "-detect.png"))
+    scene.render.image_settings.compression = 90  # a smaller file for docs/images
     engine = segment_scan.render(scene, png, args.resolution)
     if engine is None:
         raise SystemExit("detect_plate: no renderer worked headless")

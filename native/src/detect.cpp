@@ -218,17 +218,22 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
   // --- 1. robust background over the whole region --------------------------------------
   // auto: the lowest degree of 2, 4, 6 whose noise sigma is within 10% of the best (a plane or a
   // gentle curve keeps its quadric; a vase's changing radius needs the sixth degree).
+  // A low-degree polynomial over the whole region is fitted as well from an even sample of at most
+  // 20k vertices (the reweighting rounds cost a fit each), and evaluated at every vertex.
+  std::vector<int> fit_samples;
+  const std::size_t stride = (samples.size() + 19999) / 20000;
+  for (std::size_t k = 0; k < samples.size(); k += stride) fit_samples.push_back(samples[k]);
   RobustFitOptions fit_options;
   fit_options.iterations = options.robust_iterations;
   RobustFit fit;
   if (options.background_degree != kAutoDegree) {
     fit_options.degree = options.background_degree;
-    fit = fit_robust_background(mesh, samples, fit_options);
+    fit = fit_robust_background(mesh, fit_samples, fit_options);
   } else {
     std::vector<RobustFit> fits;
     for (const int degree : {2, 4, 6}) {
       fit_options.degree = degree;
-      fits.push_back(fit_robust_background(mesh, samples, fit_options));
+      fits.push_back(fit_robust_background(mesh, fit_samples, fit_options));
     }
     double best = fits[0].sigma;
     for (const RobustFit& f : fits) best = std::min(best, f.sigma);
