@@ -19,7 +19,7 @@ bl_info = {
 }
 
 _MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "mesh_io", "preview", "api",
-            "operators", "panel")
+            "operators", "panel", "multi")
 
 if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submodules
     import importlib
@@ -32,14 +32,17 @@ if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submod
 import bpy
 
 from . import pick_order, validation, summary, job, units, properties, mesh_io, preview, api, operators, panel, extract_operators, extract_panel
+from . import multi
 
-_classes = properties.classes + operators.classes + panel.classes + extract_operators.classes + extract_panel.classes
+_classes = (properties.classes + operators.classes + panel.classes + extract_operators.classes + extract_panel.classes
+            + tuple(multi.classes))
 
 
 def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
     bpy.types.Scene.relief_snake = bpy.props.PointerProperty(type=properties.ReliefSnakeSettings)
+    multi.register()
     properties.register_handlers()
 
 
@@ -53,5 +56,6 @@ def unregister():
     preview.stop()
     properties.unregister_handlers()
     del bpy.types.Scene.relief_snake
+    multi.unregister()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

@@ -27,6 +27,7 @@
 #include "batch_command.hpp"
 #include "extract_command.hpp"
 #include "parse_number.hpp"
+#include "multi_command.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/input_checks.hpp"
 #include "relief_snake/option_table.hpp"
@@ -42,6 +43,7 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  relief-snake segment MESH --picks I,J,K,... [--step-height H|auto] [options]\n"
+    "  relief-snake detect MESH [--region-vertices FILE] [--min-area A] [--out FILE] [options]\n"
     "  relief-snake measure MESH I J\n"
     "  relief-snake info MESH\n"
     "  relief-snake extract MESH RESULT.json --out DIR [options]\n"
@@ -54,7 +56,9 @@ const char* kUsage =
     "                         file, skipping invalid faces and vertices; what was skipped is reported\n"
     "\n"
     "segment: find the outline of the relief around (or beside) the picked vertices.\n"
-    "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open)\n"
+    "  --picks I,J,K,...      picked vertices in order around the relief (>= 3; >= 2 with --open);\n"
+    "                         repeat it for several reliefs: one snake each, written as one document\n"
+    "                         with a result per relief and their overlaps (docs/result-format.md)\n"
     "  --step-height H|auto   the relief's step height, in mesh units (> 0; see 'measure'); auto (the\n"
     "                         default): estimated from the picks and the surface\n"
     "  --w-int W|auto         internal-energy weight for refinement, in (0, 1]; auto (the default):\n"
@@ -214,6 +218,7 @@ int run_measure(const std::vector<std::string>& args) {
 struct SegmentArgs {
   std::string mesh_path, out_path;
   std::vector<std::int64_t> picks;
+  std::vector<std::vector<std::int64_t>> groups;  ///< every --picks, in order (picks: the first)
   rs::Options options;
   bool have_picks = false, have_height = false, have_side = false, quiet = false;
 };
@@ -241,7 +246,8 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
       if (inline_value) throw UsageError(name + " takes no value");
     };
     if (name == "--picks") {
-      a.picks = parse_picks(take_value());
+      a.groups.push_back(parse_picks(take_value()));
+      a.picks = a.groups.front();
       a.have_picks = true;
     } else if (name == "--step-height") {
       const std::string typed = take_value();
@@ -304,10 +310,11 @@ SegmentArgs parse_segment(const std::vector<std::string>& args) {
   a.mesh_path = positional[0];
   if (!a.have_picks) throw UsageError("segment needs --picks I,J,K,... (0-based vertex indices around the relief)");
   if (a.have_side && a.options.closed) throw UsageError("--relief-side only applies with --open");
-  usage_checked([&] {
-    rs::check_pick_count(a.picks.size(), a.options.closed);
-    return 0;
-  });
+  for (const auto& group : a.groups)
+    usage_checked([&] {
+      rs::check_pick_count(group.size(), a.options.closed);
+      return 0;
+    });
   return a;
 }
 
@@ -315,13 +322,17 @@ int run_segment(const std::vector<std::string>& args) {
   const SegmentArgs a = parse_segment(args);
   double load_seconds = 0;
   const rs::Mesh mesh = load_mesh(a.mesh_path, &load_seconds);
-  for (const std::int64_t p : a.picks) rs::checked_input_vertex(mesh, p, "pick");
+  for (const auto& group : a.groups)
+    for (const std::int64_t p : group) rs::checked_input_vertex(mesh, p, "pick");
   for (const auto& hole : a.options.hole_picks)
     for (const std::int64_t p : hole) rs::checked_input_vertex(mesh, p, "hole pick");
   for (const std::int64_t p : a.options.band_picks) rs::checked_input_vertex(mesh, p, "band pick");
   if (!a.quiet)
     std::fprintf(stderr, "relief-snake: loaded %s in %.2f s: %s\n", a.mesh_path.c_str(), load_seconds,
                  mesh.report().summary().c_str());
+
+  if (a.groups.size() > 1)
+    return rs::cli::run_segment_groups(mesh, a.groups, a.options, a.mesh_path, a.out_path, load_seconds, a.quiet);
 
   // Progress: at phase changes and every 25 iterations.
   std::string last_phase;
@@ -389,7 +400,7 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
-    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + rs::cli::kBatchUsage + "\n" +
+    const std::string help = std::string(kUsage) + "\n" + rs::cli::kExtractUsage + "\n" + rs::cli::kDetectUsage + "\n" + rs::cli::kBatchUsage + "\n" +
                              advanced_options_help();
     const std::string command = args[0];
     if (command == "--help" || command == "-h" || command == "help") {
@@ -410,9 +421,16 @@ int main(int argc, char** argv) {
       }
     if (command == "segment") return rs::cli::run_segment_with_extract(rest, run_segment);
     if (command == "extract") return rs::cli::run_extract(rest);
+    if (command == "detect") {
+      try {
+        return rs::cli::run_detect(rest, load_mesh);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
     if (command == "measure") return run_measure(rest);
     if (command == "info") return run_info(rest);
-    throw UsageError("unknown command '" + command + "'; use segment, measure, info or extract (see relief-snake --help)");
+    throw UsageError("unknown command '" + command + "'; use segment, detect, measure, info, extract or batch (see relief-snake --help)");
   } catch (const UsageError& e) {
     return fail(e.what(), 2);
   } catch (const rs::Error& e) {

@@ -24,9 +24,12 @@
 #include <string>
 #include <vector>
 
+#include "relief_snake/detect.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
 #include "relief_snake/input_checks.hpp"
+#include "relief_snake/multi_json.hpp"
+#include "relief_snake/multi_segment.hpp"
 #include "relief_snake/option_table.hpp"
 #include "relief_snake/result_json.hpp"
 #include "relief_snake/segment.hpp"
@@ -585,6 +588,78 @@ py::dict run_segmentation(Segmenter& segmenter, const Mesh& mesh, std::mutex* lo
   return result_dict(result, options, mesh, picks, seconds_before, seconds);
 }
 
+// --- several reliefs (segment_many, detect) -------------------------------------------
+
+/// groups: a sequence of pick sequences (not a flat list of numbers).
+std::vector<std::vector<std::int64_t>> read_groups(py::handle groups, std::int64_t n_input) {
+  if (groups.is_none() || !is_sequence(groups))
+    throw InputTypeError("groups must be a list of pick lists, e.g. [[12, 840, 77], [5, 9, 31, 2]]");
+  const py::object seq = py::reinterpret_borrow<py::object>(groups);
+  const std::size_t n = sequence_length(seq, "groups");
+  if (n == 0) throw Error("groups is empty; pass one list of picks per relief");
+  std::vector<std::vector<std::int64_t>> out;
+  for (std::size_t g = 0; g < n; ++g) {
+    const py::object item = sequence_item(seq, g, position("groups", g));
+    if (!is_sequence(item) && !PyObject_CheckBuffer(item.ptr()))
+      throw InputTypeError("groups[" + std::to_string(g) + "] is " + shown(item) +
+                           ", not a list of picks; pass one list of vertex indices per relief");
+    const std::string what = "groups[" + std::to_string(g) + "]";
+    out.push_back(read_array<std::int64_t>(item, Kind::Int, what.c_str(), false));
+    for (const std::int64_t p : out.back())
+      if (p < 0 || p >= n_input)
+        throw Error(what + ": pick " + std::to_string(p) + " is not a vertex index (0.." + std::to_string(n_input - 1) + ")");
+  }
+  return out;
+}
+
+/// The engine-side callback for a Python progress(index, phase, iteration, snaxels, contour):
+/// GIL re-acquired, the contour at most every kContourSeconds, an exception kept in *error.
+GroupProgressCallback group_progress(py::object& progress, std::exception_ptr* error, const Segmenter* running) {
+  if (progress.is_none()) return {};
+  if (!PyCallable_Check(progress.ptr()))
+    throw Error("progress must be a callable progress(index, phase, iteration, snaxels, contour) or None");
+  auto last = std::make_shared<std::pair<std::string, std::chrono::steady_clock::time_point>>();
+  return [&progress, error, last, running](std::size_t index, const Progress& p) -> bool {
+    py::gil_scoped_acquire acquire;
+    const CallbackScope scope(running);
+    if (*error) return false;
+    try {
+      const auto now = std::chrono::steady_clock::now();
+      py::object contour = py::none();
+      const std::string key = std::to_string(index) + (p.phase ? p.phase : "");
+      if (last->first != key || std::chrono::duration<double>(now - last->second).count() >= kContourSeconds) {
+        py::list points;
+        for (const Vec3& v : p.contour()) points.append(point(v));
+        contour = points;
+        *last = {key, now};
+      }
+      py::object answer = progress(index, py::str(p.phase ? p.phase : ""), p.iteration, p.snaxels, contour);
+      if (answer.is_none()) return true;
+      const int truth = PyObject_IsTrue(answer.ptr());
+      if (truth < 0) throw py::error_already_set();
+      return truth != 0;
+    } catch (...) {
+      *error = std::current_exception();
+      return false;
+    }
+  };
+}
+
+/// Contours of a document as tuples (the form the add-on takes), in place.
+void contours_as_tuples(py::dict& entry) {
+  if (!entry.contains("contour")) return;
+  py::list contour;
+  for (py::handle p : entry["contour"]) contour.append(py::tuple(py::reinterpret_borrow<py::list>(p)));
+  entry["contour"] = contour;
+}
+
+void check_not_running(const Segmenter& segmenter, const char* method) {
+  if (std::find(t_running_callbacks.begin(), t_running_callbacks.end(), &segmenter) != t_running_callbacks.end())
+    throw std::runtime_error(std::string("Mesh.") + method +
+                             " was called from its own progress callback, which would wait for itself forever; "
+                             "call it again after the running call returns, or use another Mesh");
+}
+
 /// The Python Mesh: a validated mesh and its Segmenter (planarity cache), kept together.
 class PyMesh {
  public:
@@ -598,6 +673,92 @@ class PyMesh {
                    const std::string& relief_side, int max_iterations, py::object progress, const py::kwargs& advanced) {
     const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
     return run_segmentation(*segmenter_, *mesh_, &lock_, picks, options, std::move(progress), 0.0);
+  }
+
+  py::dict segment_many(py::object groups, py::object step_height, py::object w_int, bool open_contour,
+                        const std::string& relief_side, int max_iterations, double max_overlap_share,
+                        py::object progress, const py::kwargs& advanced) {
+    check_not_running(*segmenter_, "segment_many");
+    const Options options = make_options(step_height, w_int, open_contour, relief_side, max_iterations, advanced);
+    if (!(max_overlap_share >= 0 && max_overlap_share <= 1))
+      throw Error("max_overlap_share must be in [0, 1] (the share of a region another may share), got " +
+                  std::to_string(max_overlap_share));
+    MultiSegmentOptions multi;
+    multi.max_overlap_share = max_overlap_share;
+    const auto groups_read = read_groups(groups, static_cast<std::int64_t>(mesh_->input_vertex_count()));
+    std::exception_ptr error;
+    const GroupProgressCallback callback = group_progress(progress, &error, segmenter_.get());
+    const auto start = std::chrono::steady_clock::now();
+    MultiResult result;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> guard(lock_);
+      try {
+        result = relief_snake::segment_many(*segmenter_, *mesh_, groups_read, options, callback, multi);
+      } catch (...) {
+        if (!error) throw;
+      }
+    }
+    if (error) std::rethrow_exception(error);
+    if (result.cancelled) throw CancelledError();
+    ResultContext context;
+    context.segment_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    py::dict out = to_python(multi_result_json(result, groups_read, options, *mesh_, context));
+    for (py::handle entry : out["reliefs"]) {
+      py::dict d = py::reinterpret_borrow<py::dict>(entry);
+      contours_as_tuples(d);
+    }
+    return out;
+  }
+
+  py::dict detect(py::object region_vertices, py::object min_area, py::object step_height, bool refine,
+                  py::object background_degree, py::object w_int, int max_iterations, py::object progress,
+                  const py::kwargs& advanced) {
+    check_not_running(*segmenter_, "detect");
+    DetectOptions options;
+    options.segment = make_options(step_height, w_int, false, "auto", max_iterations, advanced);
+    if (!min_area.is_none()) {
+      if (PyBool_Check(min_area.ptr()) || !PyNumber_Check(min_area.ptr()))
+        throw py::type_error("min_area must be a number > 0 (mesh units squared) or None, got " +
+                             std::string(py::str(py::repr(min_area))));
+      options.min_area = py::float_(min_area);
+      if (!std::isfinite(options.min_area) || options.min_area <= 0)
+        throw Error("min_area must be a finite number > 0 (mesh units squared), or None for the default");
+    }
+    options.refine = refine;
+    if (!background_degree.is_none()) {
+      if (PyBool_Check(background_degree.ptr()) || !PyLong_Check(background_degree.ptr()))
+        throw py::type_error("background_degree must be an int 0..6 or None (auto), got " +
+                             std::string(py::str(py::repr(background_degree))));
+      options.background_degree = background_degree.cast<int>();
+      if (options.background_degree < 0 || options.background_degree > 6)
+        throw Error("background_degree must be between 0 and 6 (2: a quadric), or None to choose it");
+    }
+    std::vector<std::int64_t> region;
+    if (!region_vertices.is_none()) {
+      region = read_array<std::int64_t>(region_vertices, Kind::Int, "region_vertices", false);
+      if (region.empty()) throw Error("region_vertices is empty; pass the region's vertex indices, or None for all");
+    }
+    std::exception_ptr error;
+    const GroupProgressCallback callback = group_progress(progress, &error, segmenter_.get());
+    DetectResult result;
+    {
+      py::gil_scoped_release release;
+      std::lock_guard<std::mutex> guard(lock_);
+      try {
+        result = relief_snake::detect(*segmenter_, *mesh_, region, options, callback);
+      } catch (...) {
+        if (!error) throw;
+      }
+    }
+    if (error) std::rethrow_exception(error);
+    if (result.cancelled) throw CancelledError();
+    py::dict out = to_python(detect_json(result, options, *mesh_, {}));
+    for (py::handle entry : out["candidates"]) {
+      py::dict d = py::reinterpret_borrow<py::dict>(entry);
+      contours_as_tuples(d);
+    }
+    return out;
   }
 
   double measure(std::int64_t i, std::int64_t j) const { return measure_distance(*mesh_, i, j); }
@@ -754,6 +915,30 @@ PYBIND11_MODULE(relief_snake_core, m) {
            py::arg("max_iterations") = 3000, py::arg("progress") = py::none(),
            "segment(picks, step_height=None, *, w_int='auto', open_contour=False, relief_side='auto', "
            "max_iterations=3000, progress=None, **advanced) -> dict (see relief_snake_core.segment)")
+      .def("segment_many", &PyMesh::segment_many, py::arg("groups"), py::arg("step_height") = py::none(),
+           py::kw_only(), py::arg("w_int") = "auto", py::arg("open_contour") = false, py::arg("relief_side") = "auto",
+           py::arg("max_iterations") = 3000, py::arg("max_overlap_share") = 0.02, py::arg("progress") = py::none(),
+           "segment_many(groups, step_height=None, *, w_int='auto', open_contour=False, relief_side='auto',\n"
+           "             max_iterations=3000, max_overlap_share=0.02, progress=None, **advanced) -> dict\n\n"
+           "groups: one list of picks per relief, e.g. [[12, 840, 77], [5, 9, 31, 2]]; one snake each, sharing this\n"
+           "Mesh's planarity cache. Returns the 'relief-snake-results/1' document (docs/result-format.md): reliefs\n"
+           "(one result document per group, in order; status 'failed' with the message when a group could not\n"
+           "run), overlaps (pairs of reliefs whose regions share vertices; a relief sharing more than\n"
+           "max_overlap_share of its area is doubtful), counts, status. progress(index, phase, iteration,\n"
+           "snaxels, contour) -> bool|None, index: the group being segmented; False raises Cancelled.")
+      .def("detect", &PyMesh::detect, py::arg("region_vertices") = py::none(), py::kw_only(),
+           py::arg("min_area") = py::none(), py::arg("step_height") = py::none(), py::arg("refine") = true,
+           py::arg("background_degree") = py::none(), py::arg("w_int") = "auto", py::arg("max_iterations") = 3000,
+           py::arg("progress") = py::none(),
+           "detect(region_vertices=None, *, min_area=None, step_height=None, refine=True, background_degree=None,\n"
+           "       w_int='auto', max_iterations=3000, progress=None, **advanced) -> dict\n\n"
+           "Proposes the reliefs of the region (vertex indices; None: the whole mesh) without picks: a robust\n"
+           "background fit, Otsu's threshold, components of at least min_area (mesh units squared; None:\n"
+           "(12 average edges)^2), split where touching reliefs stand at separate heights, each refined by the\n"
+           "snake from its own outline (refine=False: the components only). Returns the 'relief-snake-detect/1'\n"
+           "document (docs/result-format.md): candidates (each a result document plus 'detection': area,\n"
+           "height, score, outline), overlaps, background, notes. progress(index, phase, iteration, snaxels,\n"
+           "contour): index is the candidate being refined.")
       .def("measure", &PyMesh::measure, py::arg("i"), py::arg("j"),
            "measure(i, j) -> float: Euclidean distance between input vertices i and j.")
       .def("__repr__", [](const PyMesh& self) {

@@ -2,116 +2,19 @@
 // on the heights it encloses.
 #include "relief_snake/step_height.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
-#include "relief_snake/plane_fit.hpp"
+#include "relief_snake/height_statistics.hpp"
 #include "relief_snake/region.hpp"
 
 namespace relief_snake {
 namespace {
 
-struct WeightedHeight {
-  double height, weight;
-};
-
-// A quadratic height field over a plane: z(x, y) = c . (1, x, y, x^2, xy, y^2).
-struct QuadraticBackground {
-  Vec3 origin = Vec3::Zero(), e1 = Vec3::UnitX(), e2 = Vec3::UnitY(), normal = Vec3::UnitZ();
-  Eigen::Matrix<double, 6, 1> c = Eigen::Matrix<double, 6, 1>::Zero();
-  double residual = 0;
-
-  static Eigen::Matrix<double, 6, 1> basis(double x, double y) {
-    Eigen::Matrix<double, 6, 1> b;
-    b << 1, x, y, x * x, x * y, y * y;
-    return b;
-  }
-  double height(const Vec3& p) const {
-    const Vec3 d = p - origin;
-    return d.dot(normal) - basis(d.dot(e1), d.dot(e2)).dot(c);
-  }
-};
+using QuadraticBackground = PolynomialBackground;
 
 QuadraticBackground fit_background(const Mesh& mesh, const std::vector<int>& samples) {
-  QuadraticBackground fit;
-  const VertexPlaneFit plane = fit_vertex_plane(mesh, samples);
-  const double weight = plane.weight;
-  if (weight <= 0) return fit;
-  const Vec3 mean = plane.centroid;
-  fit.origin = mean;
-  fit.normal = plane.normal;
-  fit.e1 = plane.axes.col(2);
-  fit.e2 = fit.normal.cross(fit.e1);
-  // Scale the plane coordinates to about 1 so the normal equations are well conditioned.
-  const double scale = std::sqrt(std::max(plane.eigenvalues[2] / weight, 1e-300));
-  fit.e1 /= scale;
-  fit.e2 /= scale;
-  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
-  for (const int v : samples) {
-    const Vec3 d = mesh.position(v) - mean;
-    const auto phi = QuadraticBackground::basis(d.dot(fit.e1), d.dot(fit.e2));
-    A += mesh.vertex_area(v) * phi * phi.transpose();
-    b += mesh.vertex_area(v) * d.dot(fit.normal) * phi;
-  }
-  fit.c = A.ldlt().solve(b);
-  if (!fit.c.allFinite()) fit.c.setZero();
-  double sum2 = 0;
-  for (const int v : samples) sum2 += mesh.vertex_area(v) * std::pow(fit.height(mesh.position(v)), 2);
-  fit.residual = std::sqrt(sum2 / weight);
-  return fit;
-}
-
-double weighted_quantile(std::vector<WeightedHeight> values, double q) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end(), [](const WeightedHeight& a, const WeightedHeight& b) { return a.height < b.height; });
-  double total = 0;
-  for (const auto& v : values) total += v.weight;
-  double acc = 0;
-  for (const auto& v : values) {
-    acc += v.weight;
-    if (acc >= q * total) return v.height;
-  }
-  return values.back().height;
-}
-
-struct Split {
-  double threshold = 0, separation = 0;
-};
-
-// Otsu's threshold on an area-weighted histogram of the heights.
-Split otsu(const std::vector<WeightedHeight>& values, int bins) {
-  Split split;
-  if (values.size() < 2) return split;
-  const double lo = weighted_quantile(values, 0.005), hi = weighted_quantile(values, 0.995);
-  if (!(hi > lo)) return split;
-  std::vector<double> w(bins, 0), m(bins, 0);
-  double total = 0, total_mean = 0;
-  for (const auto& v : values) {
-    const int k = std::clamp(static_cast<int>((v.height - lo) / (hi - lo) * bins), 0, bins - 1);
-    w[k] += v.weight;
-    m[k] += v.weight * v.height;
-    total += v.weight;
-    total_mean += v.weight * v.height;
-  }
-  double var_total = 0;
-  for (const auto& v : values) var_total += v.weight * std::pow(v.height - total_mean / total, 2);
-  double w0 = 0, m0 = 0, best = -1;
-  for (int k = 0; k + 1 < bins; ++k) {
-    w0 += w[k];
-    m0 += m[k];
-    const double w1 = total - w0;
-    if (w0 <= 0 || w1 <= 0) continue;
-    const double mu0 = m0 / w0, mu1 = (total_mean - m0) / w1;
-    const double between = w0 * w1 * (mu1 - mu0) * (mu1 - mu0) / total;
-    if (between > best) {
-      best = between;
-      split.threshold = lo + (k + 1) * (hi - lo) / bins;
-    }
-  }
-  split.separation = var_total > 0 ? std::clamp(best / var_total, 0.0, 1.0) : 0;
-  return split;
+  return fit_polynomial_background(mesh, samples, 2);
 }
 
 std::vector<WeightedHeight> heights_of(const Mesh& mesh, const std::vector<char>& region, const QuadraticBackground& bg,
@@ -185,7 +88,7 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   }
   if (heights.empty()) return estimate;
 
-  const Split split = otsu(heights, options.histogram_bins);
+  const OtsuSplit split = otsu_split(heights, options.histogram_bins);
   std::vector<WeightedHeight> relief;
   for (const auto& v : heights)
     if (v.height > split.threshold) relief.push_back(v);

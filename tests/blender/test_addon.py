@@ -867,3 +867,88 @@ class ModalPath(AddonTestCase):
         self.assertTrue(op._job.cancel_requested)  # the worker is told to stop
         op._job.join(120)
         self.assertEqual(snapshot(), before)
+
+
+# -- several reliefs (issue 13, part 2): pick groups from vertex groups, detect and the candidate list --
+
+def _plate():
+    """A plate with several reliefs (make-scan --plate 2, 40k triangles: two touching boxes, two disks
+    and a tiny disk) and its truth, made once."""
+    if "plate" not in _CFG:
+        import json
+        import os
+        import subprocess
+        import tempfile
+        build = os.environ.get("RELIEF_SNAKE_BUILD_DIR") or os.path.join(
+            os.path.dirname(os.path.abspath(__file__)), "..", "..", "build")
+        prefix = os.path.join(tempfile.mkdtemp(prefix="relief-plate-"), "plate")
+        subprocess.run([os.path.join(build, "make-scan"), "--plate", "2", "--triangles", "40000", "--out", prefix],
+                       check=True, stdout=subprocess.DEVNULL)
+        vertices, faces = plyio.read_ply(prefix + ".ply")
+        with open(prefix + ".truth.json") as f:
+            truth = json.load(f)
+        _CFG["plate"] = {"vertices": vertices, "faces": faces, "truth": truth}
+    return _CFG["plate"]
+
+
+class SeveralReliefs(AddonTestCase):
+    def _plate_object(self):
+        return make_scan_object("Plate", _plate())
+
+    def test_detect_lists_candidates_and_applies_the_accepted(self):
+        obj = self._plate_object()
+        truth = _plate()["truth"]
+        self.assertEqual(bpy.ops.mesh.relief_snake_detect(), {'FINISHED'})
+        items = bpy.context.scene.relief_snake_candidates
+        doc = addon().multi.DETECTIONS[obj.name_full]
+        big = [r for r in truth["reliefs"] if r["area"] >= doc["parameters"]["min_area"]]
+        self.assertEqual(len(items), len(big))
+        # Reject the first candidate, accept every other one.
+        for k, item in enumerate(items):
+            item.accepted = k != 0
+        self.assertEqual(bpy.ops.mesh.relief_snake_apply_candidates(), {'FINISHED'})
+        names = [g.name for g in obj.vertex_groups]
+        self.assertNotIn("Relief.Candidate1", names)
+        for k in range(1, len(items)):
+            name = "Relief.Candidate%d" % (k + 1)
+            self.assertIn(name, names)
+            members = group_members(obj, name)
+            self.assertEqual(members, set(doc["candidates"][k]["relief_vertices"]))
+            self.assertGreaterEqual(max(iou(members, r["vertices"]) for r in big), 0.9)
+            curve = bpy.data.objects.get("Plate_%sContour" % name)
+            self.assertIsNotNone(curve)
+            self.assertEqual(curve.parent, obj)
+        # The default contour curve of a normal segmentation is not taken.
+        self.assertIsNone(bpy.data.objects.get("Plate_ReliefContour"))
+
+    def test_pick_groups_from_vertex_groups(self):
+        obj = self._plate_object()
+        truth = _plate()["truth"]
+        # The outline picks of two separate reliefs (from detect without the snake), stored as vertex
+        # groups: no click order, so the add-on orders them by angle.
+        doc = addon().multi.detect_object(obj, refine=False)
+        separate = [c for c in doc["candidates"] if c["detection"]["plateau"] == 0][:2]
+        self.assertEqual(len(separate), 2)
+        for name, c in zip(("Picks.A", "Picks.B"), separate):
+            g = obj.vertex_groups.new(name=name)
+            g.add(list(reversed(c["parameters"]["picks"])), 1.0, 'REPLACE')
+        obj.vertex_groups.new(name="Other")
+        bpy.context.scene.relief_snake.estimate_step_height = True
+        self.assertEqual(bpy.ops.mesh.relief_snake_segment_groups(prefix="Picks"), {'FINISHED'})
+        for name in ("Relief.A", "Relief.B"):
+            members = group_members(obj, name)
+            self.assertGreaterEqual(max(iou(members, r["vertices"]) for r in truth["reliefs"]), 0.9, name)
+            self.assertIsNotNone(bpy.data.objects.get("Plate_%sContour" % name))
+        self.assertNotEqual(group_members(obj, "Relief.A"), group_members(obj, "Relief.B"))
+
+    def test_pick_group_errors(self):
+        obj = self._plate_object()
+        before = snapshot()
+        with self.assertRaisesRegex(RuntimeError, "No vertex group of 'Plate' starts with 'Picks'"):
+            bpy.ops.mesh.relief_snake_segment_groups(prefix="Picks")
+        self.assertEqual(snapshot(), before)
+        g = obj.vertex_groups.new(name="Picks1")
+        g.add([0, 1], 1.0, 'REPLACE')
+        with self.assertRaisesRegex(addon().job.EngineError, "at least 3"):
+            addon().multi.segment_vertex_groups(obj, "Picks")
+        self.assertEqual([x.name for x in obj.vertex_groups], ["Picks1"])

@@ -13,6 +13,7 @@
 
 #include "relief_snake/error.hpp"
 #include "relief_snake/mesh.hpp"
+#include "plate_scans.hpp"
 #include "synthetic.hpp"
 #include "hole_scans.hpp"
 
@@ -168,7 +169,7 @@ int run_random(std::uint64_t seed, const std::string& out) {
 int run(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
-    std::cout << kUsage;
+    std::cout << kUsage << syn::kPlateUsage;
     return args.empty() ? 2 : 0;
   }
   if (args[0] == "score") {
@@ -177,6 +178,7 @@ int run(int argc, char** argv) {
     return run_score(args[1], args[2], "");
   }
   if (args[0] == "tube") return syn::tube_command(std::vector<std::string>(args.begin() + 1, args.end()));
+  if (args[0] == "--plate") return syn::run_plate_command(args);
   if (args[0] == "--random") {
     if (args.size() != 4 || args[2] != "--out")
       throw rs::Error("--random needs a seed and an output prefix: make-scan --random SEED --out PREFIX");

@@ -1,0 +1,297 @@
+"""Several reliefs in one go (issue 13, part 2): pick groups from vertex groups, and automatic
+detection with a list of candidates to accept or reject.
+
+    from relief_snake import multi
+    doc = multi.segment_vertex_groups(obj, prefix="Picks")   # one snake per group "Picks*"
+    doc = multi.detect_object(obj)                           # candidates, nothing written
+    multi.apply_candidates(obj, doc, [0, 2])                 # accepted ones -> groups + curves
+
+Each vertex group whose name starts with the prefix is one relief's picks; a vertex group has no
+click order, so its vertices are ordered by angle around their centroid (pick_order). Results are
+written like a normal segmentation: a vertex group per relief ("Relief" + what follows the prefix,
+e.g. "Picks.Lion" -> "Relief.Lion") and an outline curve "<obj>_<group>Contour" per relief.
+The operators run synchronously (the UI waits; detect on 100k triangles takes a few seconds).
+"""
+
+import bpy
+
+from . import api, mesh_io, pick_order
+from .job import MESH_CACHE, EngineError, fingerprint
+
+__all__ = ["groups_from_vertex_groups", "segment_vertex_groups", "detect_object", "apply_candidates",
+           "write_relief"]
+
+# The last detection per object (name_full -> document): the candidate list shows it.
+DETECTIONS = {}
+
+
+def _engine_mesh(obj):
+    """The engine Mesh for obj's data (through the add-on's cache, like a normal segmentation)."""
+    core = api.load_core()
+    mesh_io.sync_edit_mode(obj)
+    vertices, triangles = mesh_io.read_buffers(obj.data)
+    if not triangles:
+        raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
+    digest = fingerprint(vertices, triangles)
+    mesh = MESH_CACHE.get(obj.name_full, digest)
+    if mesh is None:
+        try:
+            mesh = core.Mesh(vertices, triangles)
+        except core.Error as exc:
+            raise EngineError(str(exc)) from None
+        MESH_CACHE.put(obj.name_full, digest, mesh)
+    return core, mesh
+
+
+def groups_from_vertex_groups(obj, prefix="Picks"):
+    """[(group name, picks)] for obj's vertex groups whose name starts with prefix, by name;
+    each group's vertices ordered by angle around their centroid."""
+    api._mesh_object(obj)
+    if not prefix:
+        raise EngineError("Give the prefix of the pick groups' names (e.g. Picks)")
+    mesh_io.sync_edit_mode(obj)
+    members = {g.index: [] for g in obj.vertex_groups if g.name.startswith(prefix)}
+    if not members:
+        raise EngineError("No vertex group of %r starts with %r: make one per relief (e.g. %s1, %s2) holding "
+                          "its picks" % (obj.name, prefix, prefix, prefix))
+    data = obj.data
+    for v in data.vertices:
+        for g in v.groups:
+            if g.group in members and g.weight > 0:
+                members[g.group].append(v.index)
+    out = []
+    for g in sorted((g for g in obj.vertex_groups if g.index in members), key=lambda g: g.name):
+        picks = members[g.index]
+        if len(picks) < 3:
+            raise EngineError("Vertex group %r holds %d vertices: a relief needs at least 3 picks around it"
+                              % (g.name, len(picks)))
+        positions = [tuple(data.vertices[i].co) for i in picks]
+        normals = [tuple(data.vertices[i].normal) for i in picks]
+        out.append((g.name, pick_order.order_by_angle(picks, positions, normals)))
+    return out
+
+
+def write_relief(obj, result, group_name):
+    """One relief: vertex group `group_name` and the curve "<obj>_<group_name>Contour".
+
+    mesh_io.write_curve fills the object's one default contour curve; the default is set aside
+    while this relief's curve takes its place, then renamed."""
+    api.apply_result(obj, result, group_name=group_name, make_curve=False)
+    contour = result.get("contour", [])
+    if len(contour) < 2:
+        return None
+    default = mesh_io.contour_object_name(obj)
+    target = "%s_%sContour" % (obj.name, group_name)
+    aside = bpy.data.objects.get(default)
+    if aside is not None:
+        aside.name = default + ".relief-snake-aside"
+    existing = bpy.data.objects.get(target)
+    if existing is not None and existing.type == 'CURVE':
+        existing.name = default
+    try:
+        ob = mesh_io.write_curve(obj, contour, result.get("closed", True))
+        ob.name = target
+        ob.data.name = target
+    finally:
+        if aside is not None:
+            aside.name = default
+    return ob
+
+
+def _result_names(names, prefix, result_prefix):
+    out = []
+    for k, name in enumerate(names):
+        rest = name[len(prefix):]
+        out.append(result_prefix + rest if rest else "%s%d" % (result_prefix, k + 1))
+    return out
+
+
+def segment_vertex_groups(obj, prefix="Picks", step_height=None, *, result_prefix="Relief", write=True,
+                          options=None):
+    """Segment one relief per vertex group named prefix*, in one call (one Segmenter: the
+    planarity is reused between reliefs of the same h). Returns the "relief-snake-results/1"
+    document with "names" (the pick groups) and "written" (the result groups). Reliefs that could
+    not run ("failed") are not written; overlapping ones are written and marked doubtful."""
+    groups = groups_from_vertex_groups(obj, prefix)
+    core, mesh = _engine_mesh(obj)
+    try:
+        doc = mesh.segment_many([p for _, p in groups], step_height, **(options or {}))
+    except core.Error as exc:
+        raise EngineError(str(exc)) from None
+    names = [n for n, _ in groups]
+    doc["names"] = names
+    doc["written"] = []
+    if write:
+        for name, result in zip(_result_names(names, prefix, result_prefix), doc["reliefs"]):
+            if result["status"] == "failed":
+                continue
+            write_relief(obj, result, name)
+            doc["written"].append(name)
+    return doc
+
+
+def detect_object(obj, *, region_vertices=None, min_area=None, refine=True, options=None):
+    """Propose the reliefs of obj (relief_snake_core.Mesh.detect); writes nothing. The document
+    is kept for the candidate list (DETECTIONS)."""
+    api._mesh_object(obj)
+    core, mesh = _engine_mesh(obj)
+    try:
+        doc = mesh.detect(region_vertices, min_area=min_area, refine=refine, **(options or {}))
+    except core.Error as exc:
+        raise EngineError(str(exc)) from None
+    DETECTIONS[obj.name_full] = doc
+    return doc
+
+
+def apply_candidates(obj, doc, accepted, *, result_prefix="Relief.Candidate"):
+    """Write the accepted candidates (indices into doc["candidates"]) like normal segmentations;
+    returns the group names written."""
+    written = []
+    candidates = doc.get("candidates", [])
+    for k in accepted:
+        if not 0 <= k < len(candidates):
+            raise EngineError("Candidate %d does not exist (the detection has %d)" % (k + 1, len(candidates)))
+        name = "%s%d" % (result_prefix, k + 1)
+        write_relief(obj, candidates[k], name)
+        written.append(name)
+    return written
+
+
+# --- Blender UI ---------------------------------------------------------------------------
+
+class ReliefSnakeCandidate(bpy.types.PropertyGroup):
+    accepted: bpy.props.BoolProperty(name="Accept", default=True,
+                                     description="Write this candidate as a vertex group and an outline curve")
+    status: bpy.props.StringProperty(name="Status")
+    step_height: bpy.props.FloatProperty(name="h")
+    area: bpy.props.FloatProperty(name="Area")
+    score: bpy.props.FloatProperty(name="Score")
+
+
+def _fill_list(context, doc):
+    items = context.scene.relief_snake_candidates
+    items.clear()
+    for k, c in enumerate(doc["candidates"]):
+        item = items.add()
+        item.name = "Candidate %d" % (k + 1)
+        item.status = c["status"]
+        item.step_height = c["step_height"]["used"]
+        item.area = c["detection"]["area"]
+        item.score = c["detection"]["score"]
+        item.accepted = c["status"] == "converged"
+    context.scene.relief_snake_candidate_index = 0
+
+
+def _report_error(op, exc):
+    op.report({'ERROR'}, str(exc))
+    return {'CANCELLED'}
+
+
+class MESH_OT_relief_snake_segment_groups(bpy.types.Operator):
+    """Segment one relief per vertex group whose name starts with the prefix (its vertices are the picks)"""
+    bl_idname = "mesh.relief_snake_segment_groups"
+    bl_label = "Segment Pick Groups"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    prefix: bpy.props.StringProperty(name="Prefix", default="Picks",
+                                     description="Vertex groups whose name starts with this hold one relief's picks")
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None and context.active_object.type == 'MESH'
+
+    def execute(self, context):
+        settings = context.scene.relief_snake
+        h = None if getattr(settings, "estimate_step_height", True) else settings.step_height
+        try:
+            doc = segment_vertex_groups(context.active_object, self.prefix, h)
+        except EngineError as exc:
+            return _report_error(self, exc)
+        bad = [n for n, r in zip(doc["names"], doc["reliefs"]) if r["status"] != "converged"]
+        self.report({'WARNING'} if bad else {'INFO'},
+                    "%d reliefs written (%s)%s" % (len(doc["written"]), ", ".join(doc["written"]),
+                                                   "; check: " + ", ".join(bad) if bad else ""))
+        return {'FINISHED'}
+
+
+class MESH_OT_relief_snake_detect(bpy.types.Operator):
+    """Propose the reliefs of the active mesh without picks; accept or reject them in the list"""
+    bl_idname = "mesh.relief_snake_detect"
+    bl_label = "Detect Reliefs"
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None and context.active_object.type == 'MESH'
+
+    def execute(self, context):
+        try:
+            doc = detect_object(context.active_object)
+        except EngineError as exc:
+            return _report_error(self, exc)
+        _fill_list(context, doc)
+        self.report({'INFO'}, "%d candidates found" % len(doc["candidates"]))
+        return {'FINISHED'}
+
+
+class MESH_OT_relief_snake_apply_candidates(bpy.types.Operator):
+    """Write the accepted candidates as vertex groups and outline curves"""
+    bl_idname = "mesh.relief_snake_apply_candidates"
+    bl_label = "Apply Accepted"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return obj is not None and obj.name_full in DETECTIONS
+
+    def execute(self, context):
+        obj = context.active_object
+        accepted = [k for k, item in enumerate(context.scene.relief_snake_candidates) if item.accepted]
+        try:
+            written = apply_candidates(obj, DETECTIONS[obj.name_full], accepted)
+        except EngineError as exc:
+            return _report_error(self, exc)
+        self.report({'INFO'}, "%d candidates written" % len(written))
+        return {'FINISHED'}
+
+
+class RELIEF_UL_candidates(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_propname, index):
+        row = layout.row(align=True)
+        row.prop(item, "accepted", text="")
+        row.label(text=item.name, icon='CHECKMARK' if item.status == "converged" else 'ERROR')
+        row.label(text="h %.3g  score %.2f" % (item.step_height, item.score))
+
+
+class VIEW3D_PT_relief_snake_multi(bpy.types.Panel):
+    bl_label = "Several Reliefs"
+    bl_idname = "VIEW3D_PT_relief_snake_multi"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Relief"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.operator("mesh.relief_snake_segment_groups", icon='GROUP_VERTEX')
+        layout.operator("mesh.relief_snake_detect", icon='VIEWZOOM')
+        scene = context.scene
+        if len(scene.relief_snake_candidates):
+            layout.template_list("RELIEF_UL_candidates", "", scene, "relief_snake_candidates", scene,
+                                 "relief_snake_candidate_index", rows=4)
+            layout.operator("mesh.relief_snake_apply_candidates", icon='CHECKMARK')
+
+
+classes = (ReliefSnakeCandidate, MESH_OT_relief_snake_segment_groups, MESH_OT_relief_snake_detect,
+           MESH_OT_relief_snake_apply_candidates, RELIEF_UL_candidates, VIEW3D_PT_relief_snake_multi)
+
+
+def register():
+    bpy.types.Scene.relief_snake_candidates = bpy.props.CollectionProperty(type=ReliefSnakeCandidate)
+    bpy.types.Scene.relief_snake_candidate_index = bpy.props.IntProperty()
+
+
+def unregister():
+    DETECTIONS.clear()
+    del bpy.types.Scene.relief_snake_candidates
+    del bpy.types.Scene.relief_snake_candidate_index
