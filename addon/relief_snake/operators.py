@@ -12,7 +12,7 @@ the timer, the draw handler and the status text go away when the run ends.
 
 import bpy
 
-from . import api, job, preview, properties, summary, units
+from . import api, job, pick_order, preview, properties, summary, units
 
 PHASES = ("intake", "segment", "coarse", "refine", "stabilise")
 
@@ -59,13 +59,15 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         if not self.group_name.strip():
             raise api.EngineError("Give the vertex group a name (Relief panel or redo panel)")
         api.load_core()
+        from . import mesh_io
         t0 = time.perf_counter()
-        picks, info = api.selected_picks(obj)
-        request = api.prepare(
-            obj, picks, None if self.estimate_step_height else self.step_height,
-            w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
-            relief_side=self.relief_side.lower(), options=_threads_option(context),
-            read_seconds=time.perf_counter() - t0, flushed=True)  # selection + click order count as data transfer too
+        with mesh_io.live_mesh(obj) as mesh:  # one read of the live mesh for the selection and the buffers
+            picks, info = api.selected_picks(obj, mesh)
+            request = api.prepare(
+                obj, picks, None if self.estimate_step_height else self.step_height,
+                w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
+                relief_side=self.relief_side.lower(), options=_threads_option(context), mesh=mesh)
+        request.read_seconds = time.perf_counter() - t0  # selection + click order count as data transfer too
         return obj, request, info
 
     def _finish(self, context, obj, result, info):
@@ -242,12 +244,12 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         try:
             api._mesh_object(obj)
             from . import mesh_io
-            mesh_io.sync_edit_mode(obj)
-            selected, _history, _, _ = mesh_io.read_selection(obj)
+            with mesh_io.live_mesh(obj) as mesh:
+                selected, _history, positions, _ = mesh_io.read_selection(obj, mesh)
             if len(selected) != 2:
                 raise api.EngineError("Select exactly two vertices, one at the foot and one at the top of the "
                                       "step (%d selected)" % len(selected))
-            h = api.measure(obj, selected[0], selected[1])
+            h = pick_order.distance(positions[selected[0]], positions[selected[1]])
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
