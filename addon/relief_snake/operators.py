@@ -12,7 +12,7 @@ the timer, the draw handler and the status text go away when the run ends.
 
 import bpy
 
-from . import api, job, pick_order, preview, properties, summary, units
+from . import api, job, pick_order, preview, properties, region_view, summary, units
 
 PHASES = ("intake", "segment", "coarse", "refine", "stabilise")
 
@@ -70,7 +70,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         request.read_seconds = time.perf_counter() - t0  # selection + click order count as data transfer too
         return obj, request, info
 
-    def _finish(self, context, obj, result, info):
+    def _finish(self, context, obj, result, info, request):
         api.apply_result(obj, result, group_name=self.group_name, make_curve=self.make_curve)
         settings = _settings(context)
         details = summary.phase_lines(result) + [summary.timing_line(result)]
@@ -90,8 +90,9 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'INFO'}, "Relief Snake: %s" % note)
         if warning:
             self.report({'WARNING'}, "Relief Snake: " + warning)
-        if self.show_region and obj.mode == 'EDIT':
-            _show_group_weights(context)
+        if self.show_region:
+            region_view.show(obj, self.group_name, request.vertices, request.triangles,
+                             result.get("relief_vertices", []))
         self.report({'INFO'}, "Relief Snake: " + settings.last_summary)
         return {'FINISHED'}
 
@@ -101,7 +102,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         try:
             obj, request, info = self._prepare(context)
             result = api.run_engine(api.load_core(), request)
-            return self._finish(context, obj, result, info)
+            return self._finish(context, obj, result, info, request)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
@@ -215,7 +216,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'ERROR'}, "The mesh changed while segmenting; nothing was written: run Segment again")
             return {'CANCELLED'}
         try:
-            return self._finish(context, obj, run.result, self._info)
+            return self._finish(context, obj, run.result, self._info, self._request)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
@@ -261,18 +262,6 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         settings.estimate_step_height = False
         self.report({'INFO'}, "Relief Snake: step height set to %s" % units.format_length(context.scene, h))
         return {'FINISHED'}
-
-
-def _show_group_weights(context):
-    """Edit Mode overlay of the active vertex group's weights, in the 3D views of this screen."""
-    screen = context.screen
-    if screen is None:
-        return
-    for area in screen.areas:
-        if area.type == 'VIEW_3D':
-            overlay = getattr(area.spaces.active, "overlay", None)
-            if overlay is not None and hasattr(overlay, "show_weight"):
-                overlay.show_weight = True
 
 
 def _redraw_views(context):

@@ -490,6 +490,24 @@ class ErrorPaths(AddonTestCase):
         self.assertEqual(snapshot(), before)
 
 
+class RegionView(AddonTestCase):
+    def test_segment_keeps_the_region_to_tint_behind_the_toggle(self):
+        region_view = addon().region_view
+        region_view.hide()
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h, show_region=False), {'FINISHED'})
+        self.assertNotIn("Scan", region_view.shown())
+        self.assertEqual(seg(step_height=self.h, show_region=True), {'FINISHED'})
+        self.assertIn("Scan", region_view.shown())
+        region_view.hide("Scan")
+        self.assertNotIn("Scan", region_view.shown())
+
+    def test_shader_names(self):
+        region_view = addon().region_view
+        self.assertEqual(region_view.builtin_shader_name((3, 4, 1)), '3D_UNIFORM_COLOR')
+        self.assertEqual(region_view.builtin_shader_name((5, 2, 3)), 'UNIFORM_COLOR')
+
+
 class PickOrder(AddonTestCase):
     def test_click_order_is_used(self):
         order = self.picks[::-1]

@@ -503,6 +503,17 @@ def scenario_artist():
     reply = yield from request(do="count", rect=vp, lo=[150, 20, 0], hi=[255, 150, 70], name="result")
     check("the orange outline is visible in the viewport", reply.get("count", 0) > 150,
           "orange pixels: %s" % reply.get("count"))
+    # The relief region, tinted green behind the Show Region toggle (on by default).
+    green = dict(lo=[0, 90, 0], hi=[120, 255, 140])
+    shown = yield from request(do="count", rect=vp, name="region-shown", **green)
+    S().show_region = False
+    yield 0.5
+    hidden = yield from request(do="count", rect=vp, name="region-hidden", **green)
+    S().show_region = True
+    yield 0.5
+    check("the relief region is tinted green in the viewport, and Show Region hides it",
+          shown.get("count", 0) > 3000 and shown.get("count", 0) - hidden.get("count", 0) > 2000,
+          "green pixels: %s shown, %s hidden" % (shown.get("count"), hidden.get("count")))
     after = scene_state(O())
 
     # Undo and redo.
