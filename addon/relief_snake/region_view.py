@@ -84,6 +84,13 @@ def _draw():
     depth, blend = gpu.state.depth_test_get(), gpu.state.blend_get()
     gpu.state.depth_test_set('LESS_EQUAL')  # on the surface, hidden behind what is in front of it
     gpu.state.blend_set('ALPHA')
+    # Blender draws the mesh with its own depth offsets (Edit Mode's faces come out nearer than
+    # their positions), so the tint at the very same positions would fail the depth test
+    # everywhere: pull it towards the viewer the way Blender offsets its overlays.
+    rv3d = context.region_data
+    gpu.matrix.push_projection()
+    gpu.matrix.load_projection_matrix(biased_projection(gpu.matrix.get_projection_matrix(),
+                                                        rv3d.view_distance if rv3d is not None else 10.0))
     try:
         for name, entry in list(_regions.items()):
             ob = scene.objects.get(name)
@@ -100,8 +107,21 @@ def _draw():
             finally:
                 gpu.matrix.pop()
     finally:
+        gpu.matrix.pop_projection()
         gpu.state.depth_test_set(depth)
         gpu.state.blend_set(blend)
+
+
+def biased_projection(projection, view_distance, amount=4.0):
+    """`projection` (4x4, row-major indexing) with its depth pulled towards the viewer: Blender's
+    GPU_polygon_offset formula, `amount` times its unit offset (orthographic: a constant, scaled by
+    the view distance; perspective: the depth term scaled by 1 + 0.25% per unit)."""
+    m = projection.copy()
+    if m[3][3] > 0.5:  # orthographic
+        m[2][3] -= 1e-5 * amount * view_distance
+    else:
+        m[2][3] *= 1.0 + 0.0025 * amount
+    return m
 
 
 def _redraw():
