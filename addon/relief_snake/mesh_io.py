@@ -131,6 +131,20 @@ def _selected_indices(mesh):
     return out
 
 
+def _edit_selected_indices(obj):
+    """The selected vertices of the edit mesh itself. (Selecting tags only the selection, so the
+    depsgraph's mesh keeps the selection of its last conversion: it cannot be read from there.)
+    When the select history holds every selected vertex (the usual picking), the selection is
+    read from it; otherwise every vertex is visited."""
+    mesh = obj.data
+    bm = bmesh.from_edit_mesh(mesh)
+    bm.verts.index_update()
+    clicked = {e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select}
+    if len(clicked) == mesh.total_vert_sel:  # the edit mesh's own count of selected vertices
+        return sorted(clicked)
+    return [v.index for v in bm.verts if v.select]
+
+
 def _click_order(obj):
     """Selected vertices in click order (Blender's select history), possibly partial."""
     mesh = obj.data
@@ -157,7 +171,7 @@ def read_selection(obj, mesh=None):
     the selected vertices only (object space).
     """
     mesh = obj.data if mesh is None else mesh
-    selected = _selected_indices(mesh)
+    selected = _edit_selected_indices(obj) if obj.mode == 'EDIT' and mesh is not obj.data else _selected_indices(mesh)
     history = _click_order(obj) if selected else []
     if obj.mode == 'EDIT' and mesh is not obj.data:
         # The edit mesh keeps its normals up to date; the depsgraph's copy would compute them all.

@@ -237,6 +237,26 @@ class SegmentOperator(AddonTestCase):
         bpy.ops.object.mode_set(mode='OBJECT')  # the group must survive leaving Edit Mode
         self.assertSegmentationMatchesTruth(self.obj)
 
+    def test_edit_mode_selection_changes_after_a_read_are_seen(self):
+        # Selecting tags only the selection, so the depsgraph keeps the mesh it converted for the
+        # last read: the selection must come from the edit mesh itself.
+        bpy.ops.object.mode_set(mode='EDIT')
+        select_vertices(self.obj, self.picks)
+        api = addon().api
+        picks, _ = api.selected_picks(self.obj)
+        self.assertEqual(picks, self.picks)
+        api.prepare(self.obj, picks, self.h)  # a read of the buffers too
+        bpy.ops.mesh.select_all(action='DESELECT')
+        self.assertEqual(api.selected_picks(self.obj)[0], [])  # nothing selected any more
+        bm = bmesh.from_edit_mesh(self.obj.data)
+        bm.verts.ensure_lookup_table()
+        for i in self.picks[:4]:  # select, no update_edit_mesh (no geometry tag)
+            bm.verts[i].select = True
+            bm.select_history.add(bm.verts[i])
+        picks, _ = api.selected_picks(self.obj)
+        self.assertEqual(picks, self.picks[:4])
+        bpy.ops.object.mode_set(mode='OBJECT')
+
     def test_edit_mode_geometry_changes_are_seen(self):
         bpy.ops.object.mode_set(mode='EDIT')
         bm = bmesh.from_edit_mesh(self.obj.data)
