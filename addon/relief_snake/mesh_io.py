@@ -131,18 +131,23 @@ def _selected_indices(mesh):
     return out
 
 
-def _edit_selected_indices(obj):
-    """The selected vertices of the edit mesh itself. (Selecting tags only the selection, so the
-    depsgraph's mesh keeps the selection of its last conversion: it cannot be read from there.)
-    When the select history holds every selected vertex (the usual picking), the selection is
-    read from it; otherwise every vertex is visited."""
+def _edit_selection(obj):
+    """(selected, history, verts) of the edit mesh itself: the selected vertices, the click order
+    and the edit bmesh's vertex sequence (with its lookup table). Selecting tags only the selection,
+    so the depsgraph's mesh keeps the selection of its last conversion: it cannot be read from there.
+    When the select history holds every selected vertex (the usual picking), the selection is the
+    history; otherwise every vertex is visited."""
     mesh = obj.data
     bm = bmesh.from_edit_mesh(mesh)
     bm.verts.index_update()
-    clicked = {e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select}
+    history = [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
+    clicked = set(history)
     if len(clicked) == mesh.total_vert_sel:  # the edit mesh's own count of selected vertices
-        return sorted(clicked)
-    return [v.index for v in bm.verts if v.select]
+        selected = sorted(clicked)
+    else:
+        selected = [v.index for v in bm.verts if v.select]
+    bm.verts.ensure_lookup_table()
+    return selected, history, bm.verts
 
 
 def _click_order(obj):
@@ -171,13 +176,13 @@ def read_selection(obj, mesh=None):
     the selected vertices only (object space).
     """
     mesh = obj.data if mesh is None else mesh
-    selected = _edit_selected_indices(obj) if obj.mode == 'EDIT' and mesh is not obj.data else _selected_indices(mesh)
-    history = _click_order(obj) if selected else []
     if obj.mode == 'EDIT' and mesh is not obj.data:
-        # The edit mesh keeps its normals up to date; the depsgraph's copy would compute them all.
-        verts = bmesh.from_edit_mesh(obj.data).verts
-        verts.ensure_lookup_table()
+        # From the edit mesh, which also keeps its normals current (the depsgraph's copy would
+        # compute them all).
+        selected, history, verts = _edit_selection(obj)
     else:
+        selected = _selected_indices(mesh)
+        history = _click_order(obj) if selected else []
         verts = mesh.vertices
     positions = {i: tuple(verts[i].co) for i in selected}
     normals = {i: tuple(verts[i].normal) for i in selected}
@@ -209,8 +214,14 @@ def write_vertex_group(obj, name, indices):
     gi = group.index
     if obj.mode == 'EDIT':
         mesh = obj.data
-        obj.vertex_groups.active_index = gi
-        if existed and not _clear_active_group_in_edit_mode(obj):
+        if obj.vertex_groups.active_index != gi:  # setting it tags the object for a new evaluation
+            obj.vertex_groups.active_index = gi
+        # With nothing evaluated on top of the edit mesh (no modifiers, no shape keys), the weights
+        # change nothing the depsgraph makes, so they are written without tagging the mesh for a new
+        # evaluation, which would make the next Segment's read convert the whole edit mesh again.
+        # Edit Mode's undo step stores the edit mesh itself, weights included.
+        retag = not _evaluated_is_edit_mesh(obj)
+        if existed and not (retag and _clear_active_group_in_edit_mode(obj)):
             bm = bmesh.from_edit_mesh(mesh)
             layer = bm.verts.layers.deform.verify()
             for v in bm.verts:  # clear the old members, one by one
@@ -223,14 +234,16 @@ def write_vertex_group(obj, name, indices):
         bverts.ensure_lookup_table()
         for i in indices:
             bverts[i][layer][gi] = 1.0
-        bmesh.update_edit_mesh(mesh, loop_triangles=False, destructive=False)
+        if retag:
+            bmesh.update_edit_mesh(mesh, loop_triangles=False, destructive=False)
     else:
         nv = len(obj.data.vertices)
         if nv and existed:
             group.remove(list(range(nv)))
         if len(indices):
             group.add(list(indices), 1.0, 'REPLACE')
-    obj.vertex_groups.active_index = gi
+    if obj.vertex_groups.active_index != gi:
+        obj.vertex_groups.active_index = gi
     return group
 
 
