@@ -596,6 +596,7 @@ def apply_at_click():
     check("the relief lies where the click was, on the target",
           off < 0.1 * max(applied.dimensions) and abs(min(p.z for p in points) - depth) < 0.1,
           "centre %.2f from the click's point; lowest z %.3f, plane at %.3f" % (off, min(p.z for p in points), depth))
+    yield 1.0  # let the window redraw before the artefact is taken
     yield from request(do="screenshot", name="applied")
 
 
