@@ -5,6 +5,9 @@ save a .blend and render a PNG of the contour on the mesh.
         --mesh scan.ply --picks 12,40,77,103 --step-height 1.0 --out DIR
     # picks and h from make-scan's ground truth instead:
     blender --background --python examples/segment_scan.py -- --mesh duck.ply --truth duck.truth.json --out DIR
+    # also extract the relief into EXTRACT (height map EXR) and put it on a sphere beside the scan:
+    blender --background --python examples/segment_scan.py -- --mesh duck.ply --truth duck.truth.json \
+        --out DIR --extract EXTRACT
 
 Works in Blender 3.4 and 4.2+ (the PLY/OBJ import operators differ; both are handled).
 Uses the installed add-on if Blender has one; otherwise the add-on from this source tree
@@ -42,6 +45,9 @@ def parse_args():
     p.add_argument("--out", required=True, help="output directory for the .blend and the .png")
     p.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
     p.add_argument("--resolution", type=int, nargs=2, default=(1280, 960))
+    p.add_argument("--extract", metavar="DIR",
+                   help="also extract the relief (height map EXR into DIR) and apply it to a sphere beside the "
+                        "scan; the picture shows both")
     args = p.parse_args(argv)
     truth = None
     if args.truth:
@@ -112,9 +118,9 @@ def import_scan(path):
     return new[0]
 
 
-def frame_camera(obj, scene):
+def frame_camera(obj, scene, others=()):
     """An orthographic camera looking at the mesh obliquely (50 degrees off its average normal),
-    so the relief's step shades against the background; a sun from the side."""
+    so the relief's step shades against the background, framing `others` too; a sun from the side."""
     mesh = obj.data
     mw = obj.matrix_world
     from mathutils import Vector
@@ -125,8 +131,8 @@ def frame_camera(obj, scene):
     from mathutils import Matrix
     side = n.orthogonal().normalized()
     view = (Matrix.Rotation(0.87, 3, side) @ n).normalized()  # tilt the view ~50 degrees
-    corners = [mw @ Vector(c) for c in obj.bound_box]
-    centre = sum(corners, Vector((0, 0, 0))) / 8
+    corners = [ob.matrix_world @ Vector(c) for ob in (obj,) + tuple(others) for c in ob.bound_box]
+    centre = sum(corners, Vector((0, 0, 0))) / len(corners)
     size = max((c - centre).length for c in corners) * 2
     cam_data = bpy.data.cameras.new("Camera")
     cam_data.type = 'ORTHO'
@@ -201,6 +207,47 @@ def style(obj, curve, relief_vertices):
         curve.data.bevel_depth = max(obj.dimensions) * 0.004
         curve.show_in_front = True  # the contour lies at the foot of the step: keep it visible
         curve.data.materials.append(_material("Contour", (1.0, 0.2, 0.0, 1.0)))
+
+
+def extract_and_apply(addon, obj, result, step_height, directory):
+    """Extract the segmented relief (height map EXR into `directory`) and put it on a UV sphere
+    beside the scan, on the sphere's top. Returns (sphere, applied relief, extraction summary)."""
+    api = addon.api
+    t0 = time.perf_counter()
+    out = api.extract_object(obj, step_height, relief_vertices=result["relief_vertices"],
+                             image_dir=os.path.abspath(directory))
+    print("segment_scan: extraction: %s (%.2f s)" % (out["result"]["summary"], time.perf_counter() - t0))
+    print("segment_scan: height map %s" % out["image_path"])
+    for ob in (out["relief"], out["base"]):
+        ob.hide_render = True  # they lie exactly on the scan
+        ob.hide_set(True)
+    from mathutils import Vector
+    size = max(obj.dimensions)
+    radius = 0.5 * size
+    corners = [obj.matrix_world @ Vector(c) for c in obj.bound_box]
+    right = max(c.x for c in corners)
+    centre = Vector((right + 1.4 * radius, sum(c.y for c in corners) / 8, min(c.z for c in corners)))
+    mesh = bpy.data.meshes.new("Sphere")
+    import bmesh
+    bm = bmesh.new()
+    bmesh.ops.create_uvsphere(bm, u_segments=192, v_segments=96, radius=radius)
+    bm.to_mesh(mesh)
+    bm.free()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    sphere = bpy.data.objects.new("Sphere", mesh)
+    bpy.context.scene.collection.objects.link(sphere)
+    sphere.location = centre
+    bpy.context.view_layer.update()
+    t0 = time.perf_counter()
+    applied = api.apply_relief(out["relief"], sphere, location=centre + Vector((0, 0, 2 * radius)))
+    print("segment_scan: applied the relief to the sphere: %d vertices in %.2f s"
+          % (len(applied.data.vertices), time.perf_counter() - t0))
+    mesh.materials.append(_material("Sphere", (0.55, 0.6, 0.7, 1.0)))
+    applied.data.materials.append(_material("Applied", (0.85, 0.6, 0.4, 1.0)))
+    for poly in applied.data.polygons:
+        poly.use_smooth = True
+    return sphere, applied, out["result"]["summary"]
 
 
 def render(scene, path, resolution):
@@ -295,9 +342,15 @@ def main():
     curve = bpy.data.objects.get(obj.name + "_ReliefContour")
     style(obj, curve, result["relief_vertices"])
     mark_picks(obj, args.picks, max(obj.dimensions) * 0.006)
-    frame_camera(obj, scene)
-    title(scene, "Relief Snake: %s - %d picks (blue), outline (orange), relief (tan), %d vertices"
-          % (os.path.basename(args.mesh), len(args.picks), len(result["relief_vertices"])))
+    text = ("Relief Snake: %s - %d picks (blue), outline (orange), relief (tan), %d vertices"
+            % (os.path.basename(args.mesh), len(args.picks), len(result["relief_vertices"])))
+    others = ()
+    if args.extract:
+        sphere, applied, _ = extract_and_apply(addon, obj, result, args.step_height, args.extract)
+        others = (sphere, applied)
+        text += "; extracted and applied to a sphere (right)"
+    frame_camera(obj, scene, others)
+    title(scene, text)
     name = os.path.splitext(os.path.basename(args.mesh))[0]
     blend = os.path.abspath(os.path.join(args.out, name + ".blend"))
     png = os.path.abspath(os.path.join(args.out, name + ".png"))

@@ -18,13 +18,15 @@ bl_info = {
     "category": "Mesh",
 }
 
-_MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "mesh_io", "preview", "api",
-            "operators", "panel", "multi")
+_MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "mesh_io", "preview",
+            "region_faces", "region_view", "api", "operators", "panel", "multi")
 
 if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submodules
     import importlib
     if "preview" in locals():
         preview.stop()  # noqa: F821  (the previous module's handler, before it is reloaded)
+    if "region_view" in locals():
+        region_view.stop()  # noqa: F821
     for _name in _MODULES:
         if _name in locals():
             importlib.reload(locals()[_name])
@@ -33,6 +35,7 @@ import bpy
 
 from . import pick_order, validation, summary, job, units, properties, mesh_io, preview, api, operators, panel, extract_operators, extract_panel
 from . import multi
+from . import region_faces, region_view
 
 _classes = (properties.classes + operators.classes + panel.classes + extract_operators.classes + extract_panel.classes
             + tuple(multi.classes))
@@ -44,6 +47,7 @@ def register():
     bpy.types.Scene.relief_snake = bpy.props.PointerProperty(type=properties.ReliefSnakeSettings)
     multi.register()
     properties.register_handlers()
+    region_view.register_handlers()
 
 
 def unregister():
@@ -54,6 +58,8 @@ def unregister():
     if running is not None:
         running._cleanup(bpy.context)
     preview.stop()
+    region_view.stop()
+    region_view.unregister_handlers()
     properties.unregister_handlers()
     del bpy.types.Scene.relief_snake
     multi.unregister()

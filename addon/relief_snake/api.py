@@ -4,8 +4,8 @@
     result = rs.segment_object(obj, picks=[12, 40, 77, 103], step_height=1.0)
     h = rs.measure(obj, 12, 13)
 
-The pipeline: prepare() reads the object's mesh data (no modifiers; Edit Mode changes are
-flushed first) into a job.Request on the main thread; job.run_engine() runs the native engine
+The pipeline: prepare() reads the object's mesh data (no modifiers; in Edit Mode the edit
+mesh as it is now, mesh_io.live_mesh) into a job.Request on the main thread; job.run_engine() runs the native engine
 (relief_snake_core) with no bpy access, so the operator runs it in a worker thread; and
 apply_result() writes the relief vertices into a vertex group and the outline into a curve
 object. Nothing is written unless the engine succeeded. Distances and step heights are in the
@@ -50,13 +50,16 @@ def _mesh_object(obj):
     return obj
 
 
-def selected_picks(obj):
+def selected_picks(obj, mesh=None):
     """Picks from the selection: (picks, info) where info is None or a sentence saying the
-    angle fallback was used (click order missing or partial)."""
+    angle fallback was used (click order missing or partial). mesh: what mesh_io.live_mesh(obj)
+    gave, if the caller holds it (default: read it here)."""
     from . import mesh_io
     _mesh_object(obj)
-    mesh_io.sync_edit_mode(obj)
-    selected, history, positions, normals = mesh_io.read_selection(obj)
+    if mesh is None:
+        with mesh_io.live_mesh(obj) as live:
+            return selected_picks(obj, live)
+    selected, history, positions, normals = mesh_io.read_selection(obj, mesh)
     return pick_order.order_picks(selected, history, positions, normals)
 
 
@@ -73,12 +76,12 @@ def measure(obj, i, j):
 
 
 def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
-            max_iterations=3000, options=None, read_seconds=0.0, flushed=False):
+            max_iterations=3000, options=None, read_seconds=0.0, mesh=None):
     """Validate and read everything the engine needs (main thread, bpy access); writes nothing.
 
     step_height None asks the engine to estimate h; w_int None lets it choose the smoothness.
-    flushed: Edit Mode changes were just flushed (selected_picks did it), so the whole-mesh copy
-    update_from_editmode makes is not made twice. Returns a job.Request; raises EngineError."""
+    mesh: what mesh_io.live_mesh(obj) gave, if the caller holds it (the operator reads the
+    selection from the same one); default: read it here. Returns a job.Request; raises EngineError."""
     from . import mesh_io
     _mesh_object(obj)
     t0 = time.perf_counter()
@@ -86,9 +89,11 @@ def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_s
         h, kwargs = validation.engine_arguments(len(picks), step_height, w_int, open_contour, relief_side)
     except ValueError as exc:
         raise EngineError(str(exc)) from None
-    if not flushed:
-        mesh_io.sync_edit_mode(obj)
-    vertices, triangles = mesh_io.read_buffers(obj.data)
+    if mesh is None:
+        with mesh_io.live_mesh(obj) as live:
+            vertices, triangles = mesh_io.read_buffers(live)
+    else:
+        vertices, triangles = mesh_io.read_buffers(mesh)
     if not triangles:
         raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
     nv = len(vertices) // 3
@@ -113,8 +118,8 @@ def mesh_changed(obj, request):
         return True
     if mesh_io.live_vertex_count(obj) != request.num_vertices:
         return True
-    mesh_io.sync_edit_mode(obj)
-    return fingerprint(*mesh_io.read_buffers(obj.data)) != request.digest
+    with mesh_io.live_mesh(obj) as mesh:
+        return fingerprint(*mesh_io.read_buffers(mesh)) != request.digest
 
 
 def segment_object(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",

@@ -15,6 +15,8 @@ FLATTEN_ITEMS = (
 )
 PLACEMENT_ITEMS = (
     ('CURSOR', "3D Cursor", "Centre the relief where the 3D cursor is (moved onto the target's surface)"),
+    ('CLICK', "Click", "Click on the target's surface in the 3D Viewport to place the relief there (then "
+                       "Location holds the point, and scale and rotation stay editable in the redo panel)"),
     ('LOCATION', "Location", "Centre the relief at the given location (moved onto the target's surface)"),
 )
 METHOD_ITEMS = (
@@ -110,26 +112,73 @@ class OBJECT_OT_relief_snake_apply(bpy.types.Operator):
         col.enabled = self.method == 'MESH'
         col.prop(self, "placement")
         sub = col.column()
-        sub.enabled = self.placement == 'LOCATION'
+        sub.enabled = self.placement in ('LOCATION', 'CLICK')
         sub.prop(self, "location")
         col.prop(self, "rotation")
         layout.prop(self, "scale")
 
-    def execute(self, context):
-        api = extraction._api()
+    def _objects_or_report(self, context):
         relief, target = self._objects(context)
         if relief is None:
             self.report({'ERROR'}, "No extracted relief: select one (made by Extract Relief) or name it")
-            return {'CANCELLED'}
-        if target is None:
+        elif target is None:
             self.report({'ERROR'}, "No target: select a second mesh object to put the relief on")
+        return relief, target
+
+    # -- placement by click: a modal pick on the target's surface ---------------------------
+    def invoke(self, context, event):
+        if self.placement != 'CLICK' or self.method != 'MESH' or context.window is None:
+            return self.execute(context)
+        relief, target = self._objects_or_report(context)
+        if relief is None or target is None:
+            return {'CANCELLED'}
+        self._target_name = target.name
+        context.window_manager.modal_handler_add(self)
+        self._status(context, "Relief Snake: click on %s to place the relief (Esc or right click cancels)"
+                     % target.name)
+        return {'RUNNING_MODAL'}
+
+    def _status(self, context, text):
+        if context.workspace is not None:
+            context.workspace.status_text_set(text)
+
+    def modal(self, context, event):
+        if event.type in {'ESC', 'RIGHTMOUSE'} and event.value == 'PRESS':
+            self._status(context, None)
+            self.report({'INFO'}, "Relief Snake: placement cancelled")
+            return {'CANCELLED'}
+        if event.type != 'LEFTMOUSE' or event.value != 'PRESS':
+            return {'PASS_THROUGH'}  # navigate the view meanwhile
+        target = bpy.data.objects.get(self._target_name)
+        ray = _view_ray(context, event.mouse_x, event.mouse_y)
+        if ray is None:
+            return {'PASS_THROUGH'}  # a click outside the 3D views: the sidebar, a menu
+        point = extraction.surface_hit(target, *ray) if target is not None else None
+        if point is None:
+            self.report({'WARNING'}, "Relief Snake: click on %s's surface (that click missed it)" % self._target_name)
+            return {'RUNNING_MODAL'}
+        self._status(context, None)
+        # The redo panel re-runs execute(): from here on, the clicked point is the location.
+        self.location = tuple(point)
+        self.target = self._target_name
+        self.placement = 'LOCATION'
+        return self.execute(context)
+
+    def execute(self, context):
+        api = extraction._api()
+        relief, target = self._objects_or_report(context)
+        if relief is None or target is None:
+            return {'CANCELLED'}
+        if self.placement == 'CLICK' and self.method == 'MESH':
+            self.report({'ERROR'}, "Placement by click needs the 3D Viewport: from a script, use placement "
+                                   "'LOCATION' with a location")
             return {'CANCELLED'}
         try:
             if self.method == 'DISPLACE':
                 modifier = extraction.add_displace(relief, target, strength=self.scale)
                 self.report({'INFO'}, "Relief Snake: Displace modifier %r on %r" % (modifier.name, target.name))
                 return {'FINISHED'}
-            location = tuple(self.location) if self.placement == 'LOCATION' else None
+            location = tuple(self.location) if self.placement == 'LOCATION' else None  # None: the 3D cursor
             ob = extraction.apply_relief(relief, target, location=location, rotation=self.rotation,
                                          scale=self.scale)
         except api.EngineError as exc:
@@ -141,6 +190,25 @@ class OBJECT_OT_relief_snake_apply(bpy.types.Operator):
         context.view_layer.objects.active = ob
         self.report({'INFO'}, "Relief Snake: %r put on %r" % (ob.name, target.name))
         return {'FINISHED'}
+
+
+def _view_ray(context, mouse_x, mouse_y):
+    """The world ray (origin, direction) through window pixel (mouse_x, mouse_y) of the 3D
+    Viewport under it, or None when no 3D Viewport is there."""
+    from bpy_extras import view3d_utils
+    screen = context.window.screen if context.window is not None else None
+    for area in (screen.areas if screen is not None else ()):
+        if area.type != 'VIEW_3D':
+            continue
+        for region in area.regions:
+            if region.type != 'WINDOW' or region.data is None:
+                continue
+            x, y = mouse_x - region.x, mouse_y - region.y
+            if 0 <= x < region.width and 0 <= y < region.height:
+                origin = view3d_utils.region_2d_to_origin_3d(region, region.data, (x, y))
+                direction = view3d_utils.region_2d_to_vector_3d(region, region.data, (x, y))
+                return origin, direction
+    return None
 
 
 classes = (MESH_OT_relief_snake_extract, OBJECT_OT_relief_snake_apply)

@@ -22,6 +22,9 @@ class VIEW3D_PT_relief_snake_extract(bpy.types.Panel):
         op.method = 'MESH'
         op = row.operator(OBJECT_OT_relief_snake_apply.bl_idname, text="Displace", icon='MODIFIER')
         op.method = 'DISPLACE'
+        op = layout.operator(OBJECT_OT_relief_snake_apply.bl_idname, text="Apply at Click", icon='RESTRICT_SELECT_OFF')
+        op.method = 'MESH'
+        op.placement = 'CLICK'
         summary = context.scene.get(LAST_EXTRACT)
         if summary:
             box = layout.box()

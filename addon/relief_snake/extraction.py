@@ -20,7 +20,7 @@ import struct
 
 import bpy
 
-from . import mesh_io
+from . import mesh_io, placement
 
 HEIGHT_ATTRIBUTE = "relief_height"
 U_ATTRIBUTE = "relief_u"
@@ -276,6 +276,21 @@ class _Surface:
         return location, normal.normalized()
 
 
+def surface_hit(target, origin, direction):
+    """Where the world ray (origin, direction) first meets mesh object `target`'s evaluated surface:
+    the world point, or None if it misses (the ray is cast in the target's own coordinates, so
+    any transform works)."""
+    from mathutils import Matrix, Vector
+    inverse = target.matrix_world.inverted_safe()
+    local_origin, local_direction = placement.ray_to_local([tuple(r) for r in inverse], tuple(origin), tuple(direction))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    hit, location, _normal, _index = target.ray_cast(Vector(local_origin), Vector(local_direction),
+                                                    depsgraph=depsgraph)
+    if not hit:
+        return None
+    return Matrix(target.matrix_world) @ location
+
+
 def apply_relief(relief, target, *, location=None, rotation=0.0, scale=1.0, name=None, rays=72, steps=48):
     """Put an extracted relief onto mesh object `target`: a new object lying on its surface.
 
@@ -286,7 +301,7 @@ def apply_relief(relief, target, *, location=None, rotation=0.0, scale=1.0, name
     flattening (geodesic polar coordinates, by marching `rays` directions in `steps` steps), then
     offset along the target's normal by its height. Returns the new object; raises EngineError.
     """
-    from mathutils import Matrix, Vector
+    from mathutils import Vector
     api = _api()
     api._mesh_object(target)
     if target == relief:
@@ -300,10 +315,7 @@ def apply_relief(relief, target, *, location=None, rotation=0.0, scale=1.0, name
     start = Vector(location) if location is not None else bpy.context.scene.cursor.location.copy()
     p0, n0 = surface.nearest(start)
     # Tangent frame at p0: the relief's u axis along the world X (or Y) projected, then rotated.
-    ref = Vector((1, 0, 0)) if abs(n0.x) < 0.9 else Vector((0, 1, 0))
-    t1 = (ref - ref.dot(n0) * n0).normalized()
-    t1 = Matrix.Rotation(rotation, 3, n0) @ t1
-    t2 = n0.cross(t1)
+    t1, t2 = (Vector(a) for a in placement.tangent_frame(tuple(n0), rotation))
 
     n = len(heights)
     cu = 0.5 * (min(us) + max(us))

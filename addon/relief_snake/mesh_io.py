@@ -12,12 +12,13 @@ data is refilled in place. (Removing and re-creating both in Edit Mode made Blen
 segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real window.)
 """
 
+import contextlib
 from array import array
 
 import bpy
 import bmesh
 
-__all__ = ["sync_edit_mode", "read_buffers", "read_selection", "vertex_position", "live_vertex_count",
+__all__ = ["sync_edit_mode", "live_mesh", "read_buffers", "read_selection", "vertex_position", "live_vertex_count",
            "write_vertex_group", "write_curve", "contour_object_name", "CONTOUR_COLOR"]
 
 CONTOUR_COLOR = (1.0, 0.32, 0.02, 1.0)  # a clear orange, unlike any of Blender's overlay colours
@@ -25,9 +26,56 @@ _MATERIAL = "Relief Snake Contour"
 
 
 def sync_edit_mode(obj):
-    """Flush Edit Mode changes to obj.data so reads see what the user sees."""
+    """Flush Edit Mode changes to obj.data so reads see what the user sees (a whole-mesh copy:
+    the reads of a segmentation use live_mesh instead)."""
     if obj.mode == 'EDIT':
         obj.update_from_editmode()
+
+
+def _evaluated_is_edit_mesh(obj):
+    """True if the depsgraph's mesh of obj in Edit Mode has the edit mesh's vertices as they are:
+    nothing (modifiers, shape keys, an armature parent) moves or adds vertices."""
+    return (not len(obj.modifiers) and obj.data.shape_keys is None and obj.parent_type != 'ARMATURE')
+
+
+@contextlib.contextmanager
+def live_mesh(obj):
+    """The mesh data the user sees now, to read from (never to write to).
+
+    Object Mode: obj.data. Edit Mode: the depsgraph's mesh of the edit mesh (object.to_mesh()).
+    Blender converts the edit mesh into it once per edit and keeps it, so reading an unchanged
+    edit mesh again costs a copy, where update_from_editmode() writes the whole edit mesh back
+    into obj.data on every call (1.3 s of a 300k-triangle Segment in Blender 3.4). When modifiers
+    or shape keys make that mesh differ from the edit mesh, obj.data is flushed as before.
+    """
+    if obj.mode != 'EDIT':
+        yield obj.data
+        return
+    if _evaluated_is_edit_mesh(obj):
+        evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        mesh = evaluated.to_mesh()
+        try:
+            if len(mesh.vertices) == len(bmesh.from_edit_mesh(obj.data).verts):
+                yield mesh
+                return
+        finally:
+            evaluated.to_mesh_clear()
+    obj.update_from_editmode()
+    yield obj.data
+
+
+# Buffer formats that take foreach_get's block copy instead of its per-item loop: Blender 3.x stores
+# a loop's vertex as an unsigned int (MLoop.v), 4.0+ as a signed int attribute (".corner_vert").
+_LOOP_VERTEX_FORMAT = 'I' if bpy.app.version < (4, 0, 0) else 'i'
+
+
+def _as_int32(buf):
+    """array('i') with the same 4-byte values as `buf` (vertex indices are far below 2**31)."""
+    if buf.typecode == 'i':
+        return buf
+    out = array('i')
+    out.frombytes(buf.tobytes())
+    return out
 
 
 def read_buffers(mesh):
@@ -35,21 +83,47 @@ def read_buffers(mesh):
 
     Returns (vertices, triangles): vertices array('f') flat 3*#V (object space), triangles
     array('i') flat 3*#T (loop triangles, so n-gons are triangulated the way Blender draws them).
+    An all-triangle mesh (every scan) reads its loops' vertices directly, in one block copy.
     """
     nv = len(mesh.vertices)
     vertices = array('f', bytes(12 * nv))
     mesh.vertices.foreach_get("co", vertices)
+    nl, nf = len(mesh.loops), len(mesh.polygons)
+    if nl == 3 * nf:  # all triangles: a triangle's loop triangle is its loops, in order
+        corner_vert = mesh.attributes.get(".corner_vert") if _LOOP_VERTEX_FORMAT == 'i' else None
+        triangles = array(_LOOP_VERTEX_FORMAT, bytes(4 * nl))
+        if corner_vert is not None and corner_vert.domain == 'CORNER' and corner_vert.data_type == 'INT':
+            corner_vert.data.foreach_get("value", triangles)
+        else:
+            mesh.loops.foreach_get("vertex_index", triangles)
+        return vertices, _as_int32(triangles)
     mesh.calc_loop_triangles()
     nt = len(mesh.loop_triangles)
-    triangles = array('i', bytes(12 * nt))
+    triangles = array(_LOOP_VERTEX_FORMAT, bytes(12 * nt))
     mesh.loop_triangles.foreach_get("vertices", triangles)
-    return vertices, triangles
+    return vertices, _as_int32(triangles)
+
+
+def _selection_flags(mesh):
+    """#V bytes, 1 for the selected vertices. The ".select_vert" attribute (3.4+) is a block copy
+    in 4.0+ (bool buffer); absent, nothing is selected."""
+    nv = len(mesh.vertices)
+    flags = bytearray(nv)
+    attribute = mesh.attributes.get(".select_vert")
+    if attribute is None:
+        return flags
+    if attribute.domain != 'POINT' or attribute.data_type != 'BOOLEAN':  # not Blender's own layer
+        mesh.vertices.foreach_get("select", flags)
+        return flags
+    if bpy.app.version >= (4, 0, 0):
+        attribute.data.foreach_get("value", memoryview(flags).cast('?'))
+    else:
+        attribute.data.foreach_get("value", flags)
+    return flags
 
 
 def _selected_indices(mesh):
-    flags = array('b', bytes(len(mesh.vertices)))
-    mesh.vertices.foreach_get("select", flags)
-    raw = flags.tobytes()
+    raw = bytes(_selection_flags(mesh))
     out, i = [], raw.find(1)
     while i >= 0:  # bytes.find skips the unselected runs in C
         out.append(i)
@@ -57,11 +131,30 @@ def _selected_indices(mesh):
     return out
 
 
+def _edit_selection(obj):
+    """(selected, history, verts) of the edit mesh itself: the selected vertices, the click order
+    and the edit bmesh's vertex sequence (with its lookup table). Selecting tags only the selection,
+    so the depsgraph's mesh keeps the selection of its last conversion: it cannot be read from there.
+    When the select history holds every selected vertex (the usual picking), the selection is the
+    history; otherwise every vertex is visited."""
+    mesh = obj.data
+    bm = bmesh.from_edit_mesh(mesh)
+    bm.verts.index_update()
+    history = [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
+    clicked = set(history)
+    if len(clicked) == mesh.total_vert_sel:  # the edit mesh's own count of selected vertices
+        selected = sorted(clicked)
+    else:
+        selected = [v.index for v in bm.verts if v.select]
+    bm.verts.ensure_lookup_table()
+    return selected, history, bm.verts
+
+
 def _click_order(obj):
     """Selected vertices in click order (Blender's select history), possibly partial."""
     mesh = obj.data
     if obj.mode == 'EDIT':
-        bm = bmesh.from_edit_mesh(mesh)  # the live edit mesh: no copy
+        bm = bmesh.from_edit_mesh(mesh)  # the live edit mesh: no copy; the history is a short list
         bm.verts.index_update()
         return [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
     # Object Mode: the click order is stored with the mesh (MSelect) and only bmesh reads it
@@ -74,17 +167,23 @@ def _click_order(obj):
         bm.free()
 
 
-def read_selection(obj):
+def read_selection(obj, mesh=None):
     """Selected vertices and their click order.
 
-    Returns (selected, history, positions, normals): selected list[int]; history list[int] in
-    click order (may be partial or empty); positions and normals dicts {index: (x, y, z)} for
-    the selected vertices only (object space). Call sync_edit_mode(obj) first in Edit Mode.
+    mesh: what live_mesh(obj) gave (default: obj.data, so call sync_edit_mode(obj) first in Edit
+    Mode). Returns (selected, history, positions, normals): selected list[int]; history list[int]
+    in click order (may be partial or empty); positions and normals dicts {index: (x, y, z)} for
+    the selected vertices only (object space).
     """
-    mesh = obj.data
-    selected = _selected_indices(mesh)
-    history = _click_order(obj) if selected else []
-    verts = mesh.vertices
+    mesh = obj.data if mesh is None else mesh
+    if obj.mode == 'EDIT' and mesh is not obj.data:
+        # From the edit mesh, which also keeps its normals current (the depsgraph's copy would
+        # compute them all).
+        selected, history, verts = _edit_selection(obj)
+    else:
+        selected = _selected_indices(mesh)
+        history = _click_order(obj) if selected else []
+        verts = mesh.vertices
     positions = {i: tuple(verts[i].co) for i in selected}
     normals = {i: tuple(verts[i].normal) for i in selected}
     return selected, history, positions, normals
@@ -109,30 +208,55 @@ def write_vertex_group(obj, name, indices):
     Returns the group, which becomes the active one.
     """
     group = obj.vertex_groups.get(name)
+    existed = group is not None
     if group is None:
         group = obj.vertex_groups.new(name=name)
     gi = group.index
     if obj.mode == 'EDIT':
         mesh = obj.data
+        if obj.vertex_groups.active_index != gi:  # setting it tags the object for a new evaluation
+            obj.vertex_groups.active_index = gi
+        # With nothing evaluated on top of the edit mesh (no modifiers, no shape keys), the weights
+        # change nothing the depsgraph makes, so they are written without tagging the mesh for a new
+        # evaluation, which would make the next Segment's read convert the whole edit mesh again.
+        # Edit Mode's undo step stores the edit mesh itself, weights included.
+        retag = not _evaluated_is_edit_mesh(obj)
+        if existed and not (retag and _clear_active_group_in_edit_mode(obj)):
+            bm = bmesh.from_edit_mesh(mesh)
+            layer = bm.verts.layers.deform.verify()
+            for v in bm.verts:  # clear the old members, one by one
+                weights = v[layer]
+                if gi in weights:
+                    del weights[gi]
         bm = bmesh.from_edit_mesh(mesh)
         layer = bm.verts.layers.deform.verify()
         bverts = bm.verts
-        for v in bverts:  # clear the old members
-            weights = v[layer]
-            if gi in weights:
-                del weights[gi]
         bverts.ensure_lookup_table()
         for i in indices:
             bverts[i][layer][gi] = 1.0
-        bmesh.update_edit_mesh(mesh, loop_triangles=False, destructive=False)
+        if retag:
+            bmesh.update_edit_mesh(mesh, loop_triangles=False, destructive=False)
     else:
         nv = len(obj.data.vertices)
-        if nv:
+        if nv and existed:
             group.remove(list(range(nv)))
         if len(indices):
             group.add(list(indices), 1.0, 'REPLACE')
-    obj.vertex_groups.active_index = gi
+    if obj.vertex_groups.active_index != gi:
+        obj.vertex_groups.active_index = gi
     return group
+
+
+def _clear_active_group_in_edit_mode(obj):
+    """Take every vertex out of obj's active vertex group in the edit mesh, in C: Blender's own
+    "Remove from All" (object.vertex_group_remove_from, use_all_verts), which clears the edit
+    bmesh's deform layer without removing the group. Called from inside an operator, it adds no
+    undo step of its own. False if it could not run (then the caller clears vertex by vertex)."""
+    try:
+        with bpy.context.temp_override(object=obj, active_object=obj):
+            return 'FINISHED' in bpy.ops.object.vertex_group_remove_from(use_all_groups=False, use_all_verts=True)
+    except (RuntimeError, AttributeError, TypeError):  # poll failed, or no temp_override
+        return False
 
 
 def contour_object_name(obj):

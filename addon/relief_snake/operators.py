@@ -12,7 +12,7 @@ the timer, the draw handler and the status text go away when the run ends.
 
 import bpy
 
-from . import api, job, preview, properties, summary, units
+from . import api, job, pick_order, preview, properties, region_view, summary, units
 
 PHASES = ("intake", "segment", "coarse", "refine", "stabilise")
 
@@ -59,16 +59,18 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         if not self.group_name.strip():
             raise api.EngineError("Give the vertex group a name (Relief panel or redo panel)")
         api.load_core()
+        from . import mesh_io
         t0 = time.perf_counter()
-        picks, info = api.selected_picks(obj)
-        request = api.prepare(
-            obj, picks, None if self.estimate_step_height else self.step_height,
-            w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
-            relief_side=self.relief_side.lower(), options=_threads_option(context),
-            read_seconds=time.perf_counter() - t0, flushed=True)  # selection + click order count as data transfer too
+        with mesh_io.live_mesh(obj) as mesh:  # one read of the live mesh for the selection and the buffers
+            picks, info = api.selected_picks(obj, mesh)
+            request = api.prepare(
+                obj, picks, None if self.estimate_step_height else self.step_height,
+                w_int=None if self.auto_smoothness else self.smoothness, open_contour=self.open_contour,
+                relief_side=self.relief_side.lower(), options=_threads_option(context), mesh=mesh)
+        request.read_seconds = time.perf_counter() - t0  # selection + click order count as data transfer too
         return obj, request, info
 
-    def _finish(self, context, obj, result, info):
+    def _finish(self, context, obj, result, info, request):
         api.apply_result(obj, result, group_name=self.group_name, make_curve=self.make_curve)
         settings = _settings(context)
         details = summary.phase_lines(result) + [summary.timing_line(result)]
@@ -88,8 +90,9 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'INFO'}, "Relief Snake: %s" % note)
         if warning:
             self.report({'WARNING'}, "Relief Snake: " + warning)
-        if self.show_region and obj.mode == 'EDIT':
-            _show_group_weights(context)
+        if self.show_region:
+            region_view.show(obj, self.group_name, request.vertices, request.triangles,
+                             result.get("relief_vertices", []))
         self.report({'INFO'}, "Relief Snake: " + settings.last_summary)
         return {'FINISHED'}
 
@@ -99,7 +102,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         try:
             obj, request, info = self._prepare(context)
             result = api.run_engine(api.load_core(), request)
-            return self._finish(context, obj, result, info)
+            return self._finish(context, obj, result, info, request)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
@@ -213,7 +216,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'ERROR'}, "The mesh changed while segmenting; nothing was written: run Segment again")
             return {'CANCELLED'}
         try:
-            return self._finish(context, obj, run.result, self._info)
+            return self._finish(context, obj, run.result, self._info, self._request)
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
@@ -242,12 +245,12 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         try:
             api._mesh_object(obj)
             from . import mesh_io
-            mesh_io.sync_edit_mode(obj)
-            selected, _history, _, _ = mesh_io.read_selection(obj)
+            with mesh_io.live_mesh(obj) as mesh:
+                selected, _history, positions, _ = mesh_io.read_selection(obj, mesh)
             if len(selected) != 2:
                 raise api.EngineError("Select exactly two vertices, one at the foot and one at the top of the "
                                       "step (%d selected)" % len(selected))
-            h = api.measure(obj, selected[0], selected[1])
+            h = pick_order.distance(positions[selected[0]], positions[selected[1]])
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
@@ -259,18 +262,6 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         settings.estimate_step_height = False
         self.report({'INFO'}, "Relief Snake: step height set to %s" % units.format_length(context.scene, h))
         return {'FINISHED'}
-
-
-def _show_group_weights(context):
-    """Edit Mode overlay of the active vertex group's weights, in the 3D views of this screen."""
-    screen = context.screen
-    if screen is None:
-        return
-    for area in screen.areas:
-        if area.type == 'VIEW_3D':
-            overlay = getattr(area.spaces.active, "overlay", None)
-            if overlay is not None and hasattr(overlay, "show_weight"):
-                overlay.show_weight = True
 
 
 def _redraw_views(context):

@@ -62,7 +62,7 @@ def setting_properties(update=None):
             description="Also make (or update) an orange curve object along the outline", **kw),
         "show_region": BoolProperty(
             name="Show Region", default=True,
-            description="After a run in Edit Mode, show the relief group's weights in the viewport", **kw),
+            description="Tint the relief region green in the viewport after a run (Object and Edit Mode)", **kw),
     }
 
 

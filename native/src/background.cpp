@@ -14,6 +14,8 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
+#include "sparse_spd.hpp"
+
 namespace relief_snake {
 
 const char* to_string(BackgroundStatus status) {
@@ -404,14 +406,11 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
       rhs.row(u) += weight * value(v).head(dims).transpose();
     }
   }
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt(Q);
-  if (ldlt.info() != Eigen::Success)
+  Eigen::MatrixXd X;
+  if (!solve_spd(Q, rhs, &X))
     return failure(BackgroundStatus::NoRing,
                    "the background fill is singular: the region has too little background around it; segment a smaller "
                    "region or use a larger ring");
-  const Eigen::MatrixXd X = ldlt.solve(rhs);
-  if (ldlt.info() != Eigen::Success || !X.allFinite())
-    return failure(BackgroundStatus::NoRing, "the background fill failed; segment a smaller region");
 
   // --- base positions, normals and heights.
   r.base_positions.resize(static_cast<std::size_t>(nv));

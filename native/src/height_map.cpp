@@ -11,6 +11,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "relief_snake/error.hpp"
+#include "sparse_spd.hpp"
 
 namespace relief_snake {
 
@@ -193,10 +194,9 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
   Eigen::SparseMatrix<double> A(2 * static_cast<Eigen::Index>(nt), 2 * nfree);
   A.setFromTriplets(entries.begin(), entries.end());
   const Eigen::SparseMatrix<double> AtA = A.transpose() * A;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(AtA);
-  if (ldlt.info() != Eigen::Success) return false;
-  const Eigen::VectorXd x = ldlt.solve(A.transpose() * rhs);
-  if (ldlt.info() != Eigen::Success || !x.allFinite()) return false;
+  Eigen::MatrixXd solution;
+  if (!solve_spd(AtA, Eigen::MatrixXd(A.transpose() * rhs), &solution)) return false;
+  const Eigen::VectorXd x = solution.col(0);
   uv->resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) (*uv)[i] = pinned[i] ? plane[i] : Vec2(x[id[i]], x[nfree + id[i]]);
   double area2 = 0;

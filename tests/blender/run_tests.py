@@ -107,7 +107,9 @@ def main():
 
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()
-    for name in ("test_pick_order", "test_validation", "test_summary", "test_job", "test_addon", "test_extraction"):
+    for name in ("test_pick_order", "test_validation", "test_summary", "test_job", "test_placement", "test_region_faces",
+                 "test_addon",
+                 "test_extraction"):
         suite.addTests(loader.loadTestsFromName(name))
     t0 = time.perf_counter()
     result = unittest.TextTestRunner(verbosity=2, stream=sys.stdout).run(suite)

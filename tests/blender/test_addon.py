@@ -238,6 +238,26 @@ class SegmentOperator(AddonTestCase):
         bpy.ops.object.mode_set(mode='OBJECT')  # the group must survive leaving Edit Mode
         self.assertSegmentationMatchesTruth(self.obj)
 
+    def test_edit_mode_selection_changes_after_a_read_are_seen(self):
+        # Selecting tags only the selection, so the depsgraph keeps the mesh it converted for the
+        # last read: the selection must come from the edit mesh itself.
+        bpy.ops.object.mode_set(mode='EDIT')
+        select_vertices(self.obj, self.picks)
+        api = addon().api
+        picks, _ = api.selected_picks(self.obj)
+        self.assertEqual(picks, self.picks)
+        api.prepare(self.obj, picks, self.h)  # a read of the buffers too
+        bpy.ops.mesh.select_all(action='DESELECT')
+        self.assertEqual(api.selected_picks(self.obj)[0], [])  # nothing selected any more
+        bm = bmesh.from_edit_mesh(self.obj.data)
+        bm.verts.ensure_lookup_table()
+        for i in self.picks[:4]:  # select, no update_edit_mesh (no geometry tag)
+            bm.verts[i].select = True
+            bm.select_history.add(bm.verts[i])
+        picks, _ = api.selected_picks(self.obj)
+        self.assertEqual(picks, self.picks[:4])
+        bpy.ops.object.mode_set(mode='OBJECT')
+
     def test_edit_mode_geometry_changes_are_seen(self):
         bpy.ops.object.mode_set(mode='EDIT')
         bm = bmesh.from_edit_mesh(self.obj.data)
@@ -489,6 +509,24 @@ class ErrorPaths(AddonTestCase):
         self.assertTrue(snake_calls, calls)
         self.assertGreater(snake_calls[0][3], 0, "progress got an empty contour")
         self.assertEqual(snapshot(), before)
+
+
+class RegionView(AddonTestCase):
+    def test_segment_keeps_the_region_to_tint_behind_the_toggle(self):
+        region_view = addon().region_view
+        region_view.hide()
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h, show_region=False), {'FINISHED'})
+        self.assertNotIn("Scan", region_view.shown())
+        self.assertEqual(seg(step_height=self.h, show_region=True), {'FINISHED'})
+        self.assertIn("Scan", region_view.shown())
+        region_view.hide("Scan")
+        self.assertNotIn("Scan", region_view.shown())
+
+    def test_shader_names(self):
+        region_view = addon().region_view
+        self.assertEqual(region_view.builtin_shader_name((3, 4, 1)), '3D_UNIFORM_COLOR')
+        self.assertEqual(region_view.builtin_shader_name((5, 2, 3)), 'UNIFORM_COLOR')
 
 
 class PickOrder(AddonTestCase):

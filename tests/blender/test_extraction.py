@@ -189,6 +189,44 @@ class Apply(ExtractionTestCase):
         self.assertAlmostEqual(d.x, -dv, delta=0.03 * abs(du))
         self.assertAlmostEqual(d.y, du, delta=0.03 * abs(du))
 
+    def test_click_placement_hits_the_target_where_the_ray_meets_it(self):
+        from relief_snake import extraction
+        target = self.sphere()
+        target.location = (100.0, 0.0, 0.0)
+        target.scale = (1.0, 1.0, 0.5)  # an ellipsoid: the ray is cast in the target's own coordinates
+        bpy.context.view_layer.update()
+        point = extraction.surface_hit(target, (100.0, 0.0, 500.0), (0.0, 0.0, -1.0))
+        self.assertIsNotNone(point)
+        self.assertAlmostEqual(point.x, 100.0, places=3)
+        self.assertAlmostEqual(point.y, 0.0, places=3)
+        self.assertAlmostEqual(point.z, 20.0, delta=0.02)  # the top of the squashed sphere
+        self.assertIsNone(extraction.surface_hit(target, (0.0, 0.0, 500.0), (0.0, 0.0, -1.0)))  # beside it
+        # What the modal pick does with the hit: apply at that location (the redo panel's state).
+        for ob in bpy.context.selected_objects:
+            ob.select_set(False)
+        self.relief.select_set(True)
+        target.select_set(True)
+        bpy.context.view_layer.objects.active = self.relief
+        self.assertEqual(bpy.ops.object.relief_snake_apply(placement='LOCATION', location=tuple(point)),
+                         {'FINISHED'})
+        applied = bpy.context.active_object
+        centre = sum((applied.matrix_world @ v.co for v in applied.data.vertices), Vector()) / len(applied.data.vertices)
+        self.assertLess(math.hypot(centre.x - 100.0, centre.y), 0.1 * max(applied.dimensions))
+        self.assertGreater(centre.z, 19.0)
+
+    def test_click_placement_needs_a_viewport(self):
+        target = self.sphere()
+        for ob in bpy.context.selected_objects:
+            ob.select_set(False)
+        self.relief.select_set(True)
+        target.select_set(True)
+        bpy.context.view_layer.objects.active = self.relief
+        before = snapshot()
+        with self.assertRaises(RuntimeError) as raised:  # background: no window to click in
+            bpy.ops.object.relief_snake_apply('INVOKE_DEFAULT', placement='CLICK')
+        self.assertIn("3D Viewport", str(raised.exception))
+        self.assertEqual(snapshot(), before)
+
     def test_displace_modifier_alternative(self):
         bpy.ops.mesh.primitive_plane_add(size=100, location=(0, 0, 0))
         target = bpy.context.active_object

@@ -14,6 +14,7 @@ to DIR/log.txt. Scenarios:
 
 import hashlib
 import json
+import math
 import os
 import subprocess
 import sys
@@ -21,6 +22,7 @@ import time
 import traceback
 
 import bpy
+from mathutils import Vector
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # tests/blender: plyio
@@ -470,7 +472,7 @@ def scenario_artist():
     real_progress = job_mod.SegmentJob._progress
 
     def slow_progress(self, *args):
-        time.sleep(0.02)
+        time.sleep(0.05)  # about 20 s in all: a screenshot and its count take 4-5 s on a loaded machine
         return real_progress(self, *args)
     job_mod.SegmentJob._progress = slow_progress
     started = yield from press_segment(button, wait=False)
@@ -503,6 +505,17 @@ def scenario_artist():
     reply = yield from request(do="count", rect=vp, lo=[150, 20, 0], hi=[255, 150, 70], name="result")
     check("the orange outline is visible in the viewport", reply.get("count", 0) > 150,
           "orange pixels: %s" % reply.get("count"))
+    # The relief region, tinted green behind the Show Region toggle (on by default).
+    green = dict(lo=[0, 110, 0], hi=[110, 255, 130])  # greens only: a grey with g >= 110 has r > 110
+    shown = yield from request(do="count", rect=vp, name="region-shown", **green)
+    S().show_region = False
+    yield 0.5
+    hidden = yield from request(do="count", rect=vp, name="region-hidden", **green)
+    S().show_region = True
+    yield 0.5
+    check("the relief region is tinted green in the viewport, and Show Region hides it",
+          shown.get("count", 0) > 3000 and shown.get("count", 0) - hidden.get("count", 0) > 2000,
+          "green pixels: %s shown, %s hidden" % (shown.get("count"), hidden.get("count")))
     after = scene_state(O())
 
     # Undo and redo.
@@ -539,6 +552,52 @@ def scenario_artist():
     check("an empty selection reports what to do", "Select at least 3 vertices" in text, text[-300:])
     check("a failed run changes nothing", scene_state(O()) == state)
     del before, after
+    yield from apply_at_click()
+
+
+def apply_at_click():
+    """Extract the relief, then Apply at Click: a real click on a plane target under the scan puts
+    the relief there (the ray is cast against the target only)."""
+    with override():
+        bpy.ops.object.mode_set(mode='OBJECT')
+        extracted = bpy.ops.mesh.relief_snake_extract() == {'FINISHED'}
+    if not check("Extract makes the relief", extracted and bpy.data.objects.get("Scan_Relief") is not None):
+        return
+    scan = O()
+    corners = [scan.matrix_world @ Vector(c) for c in scan.bound_box]
+    depth = min(c.z for c in corners) - 5.0
+    mesh = bpy.data.meshes.new("Target")
+    size = 2 * max(scan.dimensions)
+    mesh.from_pydata([(-size, -size, depth), (size, -size, depth), (size, size, depth), (-size, size, depth)], [],
+                     [(0, 1, 2, 3)])
+    target = bpy.data.objects.new("Target", mesh)
+    bpy.context.scene.collection.objects.link(target)
+    bpy.context.view_layer.update()
+    with override():
+        started = bpy.ops.object.relief_snake_apply('INVOKE_DEFAULT', relief="Scan_Relief", target="Target",
+                                                    method='MESH', placement='CLICK')
+    check("Apply at Click waits for a click", started == {'RUNNING_MODAL'}, started)
+    # Click a quarter of the way in from the viewport's left edge: where the ray meets the plane.
+    from bpy_extras.view3d_utils import region_2d_to_origin_3d, region_2d_to_vector_3d
+    win, area, region, _ = view3d()
+    rv3d = area.spaces.active.region_3d
+    at = (region.width // 3, region.height // 2)
+    origin, direction = region_2d_to_origin_3d(region, rv3d, at), region_2d_to_vector_3d(region, rv3d, at)
+    t = (depth - origin.z) / direction.z
+    expected = origin + t * direction
+    yield from click(to_x(win, region.x + at[0], region.y + at[1]))
+    placed = yield from wait_until(lambda: bpy.data.objects.get("Scan_Relief_Applied") is not None, 20, 0.2)
+    applied = bpy.data.objects.get("Scan_Relief_Applied")
+    if not check("the click puts the relief on the target", placed and applied is not None):
+        return
+    points = [applied.matrix_world @ v.co for v in applied.data.vertices]
+    centre = sum(points, Vector()) / len(points)
+    off = math.hypot(centre.x - expected.x, centre.y - expected.y)
+    check("the relief lies where the click was, on the target",
+          off < 0.1 * max(applied.dimensions) and abs(min(p.z for p in points) - depth) < 0.1,
+          "centre %.2f from the click's point; lowest z %.3f, plane at %.3f" % (off, min(p.z for p in points), depth))
+    yield 1.0  # let the window redraw before the artefact is taken
+    yield from request(do="screenshot", name="applied")
 
 
 def main_coroutine():

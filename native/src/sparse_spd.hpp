@@ -1,0 +1,18 @@
+#pragma once
+// One sparse symmetric positive definite solve, shared by the background fill (background.cpp)
+// and the conformal flattening (height_map.cpp): CHOLMOD from SuiteSparse (which picks
+// supernodal or simplicial and the AMD or METIS ordering itself) when the build has it
+// (CMake option RELIEF_SNAKE_WITH_CHOLMOD), else Eigen's SimplicialLDLT.
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+
+namespace relief_snake {
+
+/// X (#A by #B cols) = A^-1 B for A (n by n, symmetric positive definite; both triangles
+/// stored) and B (n by k). False if the factorisation or the solve fails or X is not finite.
+bool solve_spd(const Eigen::SparseMatrix<double>& A, const Eigen::MatrixXd& B, Eigen::MatrixXd* X);
+
+/// "cholmod" or "eigen-simplicial-ldlt": which solver this build uses (for benchmarks and notes).
+const char* spd_solver_name();
+
+}  // namespace relief_snake
