@@ -13,15 +13,17 @@ case "$build_dir" in /*) ;; *) build_dir=$PWD/$build_dir ;; esac  # BUILD_DIR ma
 export RELIEF_SNAKE_BUILD_DIR=${RELIEF_SNAKE_BUILD_DIR:-$build_dir}
 PYTHON=${PYTHON:-python3}
 
-if ! ls "$build_dir"/py313/relief_snake_core.cpython-313-*.so >/dev/null 2>&1; then
-  echo "== building the cp313 module for bpy 5.2 (scripts/package.sh does the same)"
+# Configured once, built every time (incremental): a module left from older sources would test them.
+if [ ! -f "$build_dir/py313/CMakeCache.txt" ]; then
+  echo "== configuring the cp313 module for bpy 5.2 (scripts/package.sh does the same)"
   PY313=${PY313:-$(ls /root/.pyenv/versions/3.13.*/bin/python3.13 "$HOME"/.pyenv/versions/3.13.*/bin/python3.13 2>/dev/null | head -1 || command -v python3.13)}
   VENV313=${VENV_PY313:-.venv-py313}
   "$VENV313/bin/python" -c "import pybind11" >/dev/null 2>&1 || { "$PY313" -m venv "$VENV313"; "$VENV313/bin/python" -m pip install -q pybind11; }
   cmake -S . -B "$build_dir/py313" -DCMAKE_BUILD_TYPE=Release -DRELIEF_SNAKE_BUILD_TESTS=OFF \
     -DPython3_EXECUTABLE="$PWD/$VENV313/bin/python" -Dpybind11_DIR="$("$VENV313/bin/python" -m pybind11 --cmakedir)" >/dev/null
-  cmake --build "$build_dir/py313" --target relief_snake_core -j "${JOBS:-2}"
 fi
+echo "== the cp313 module for bpy 5.2"
+cmake --build "$build_dir/py313" --target relief_snake_core -j "${JOBS:-2}"
 
 echo "== bpy-free add-on logic (pytest)"
 "$PYTHON" -m pytest -q tests/blender

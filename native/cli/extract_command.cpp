@@ -205,6 +205,11 @@ int run_segment_with_extract(const std::vector<std::string>& args,
       if (!extract_args.empty()) throw ExtractUsage("--pixel-size and --flatten need --extract DIR");
       return segment(segment_args);
     }
+    int pick_groups = 0;
+    for (const std::string& arg : segment_args) pick_groups += arg == "--picks" || arg.rfind("--picks=", 0) == 0;
+    if (pick_groups > 1)
+      throw ExtractUsage("--extract takes one relief: give one --picks (extract the others with relief-snake "
+                         "extract MESH RESULT.json, one result each)");
     // The mesh: segment's one positional argument (options with values are skipped).
     for (std::size_t k = 0; k < segment_args.size(); ++k) {
       const std::string& arg = segment_args[k];

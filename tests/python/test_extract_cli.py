@@ -241,3 +241,14 @@ def test_errors_are_one_line_and_write_nothing(cli, extracted, tmp_path):
     one_error_line(run(cli, "extract", mesh, out / "result.json", "--out", target, "--pixel-size", "-1"), 2)
     one_error_line(run(cli, "extract", mesh, "--out", target), 2)
     assert not target.exists()
+
+
+def test_segment_extract_with_several_pick_groups_is_refused_up_front(cli, scan, tmp_path):
+    """--extract takes one relief; with two --picks it says so before segmenting anything."""
+    mesh, truth = scan
+    picks = ",".join(map(str, truth["picks"]))
+    target = tmp_path / "two"
+    line = one_error_line(run(cli, "segment", mesh, "--picks", picks, "--picks", picks, "--step-height", "1",
+                              "--extract", target), 2)
+    assert "one --picks" in line
+    assert not target.exists()
