@@ -6,7 +6,7 @@
 # It reports numbers; it does not fail on them (it exits non-zero only if it cannot run).
 # Environment: BUILD_DIR [build], PYTHON [python3], JOBS [2] (build), BENCH_JOBS [2] (parallel
 # runs), BENCH_ARGS (extra arguments for run_bench.py, e.g. --quick or --keep-scans),
-# BENCH_SECTIONS ["main random extract"], RANDOM_SEEDS [0:200], RANDOM_ARGS (extra arguments for
+# BENCH_SECTIONS ["main random extract whole detect"], RANDOM_SEEDS [0:200], RANDOM_ARGS (extra arguments for
 # random_suite.py, e.g. --variant NAME=OPTIONS; without --variant it runs defaults, paper, old-defaults).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,7 +24,7 @@ echo "bench: building relief-snake and make-scan in $BUILD_DIR" >&2
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE="$(command -v "$PYTHON")" >/dev/null
 cmake --build "$BUILD_DIR" -j "${JOBS:-2}" --target relief-snake make-scan >/dev/null
 
-SECTIONS=${BENCH_SECTIONS:-main random extract}
+SECTIONS=${BENCH_SECTIONS:-main random extract whole detect}
 # shellcheck disable=SC2086
 if [[ " $SECTIONS " == *" main "* ]]; then
   "$PYTHON" bench/run_bench.py --build-dir "$BUILD_DIR" ${BENCH_ARGS:-}
@@ -38,4 +38,14 @@ fi
 if [[ " $SECTIONS " == *" extract "* ]]; then
   mkdir -p bench/results
   "$PYTHON" bench/extract_bench.py --build "$BUILD_DIR" --triangles 100000,290000 --json bench/results/extract.json
+fi
+# Issue 13: holes and bands (bench/results/whole-reliefs), and detection on generated plates.
+# shellcheck disable=SC2086
+if [[ " $SECTIONS " == *" whole "* ]]; then
+  "$PYTHON" -m bench.whole_reliefs --build "$BUILD_DIR" --out bench/results/whole-reliefs
+fi
+# shellcheck disable=SC2086
+if [[ " $SECTIONS " == *" detect "* ]]; then
+  "$PYTHON" bench/detect_suite.py --cli "$BUILD_DIR/relief-snake" --make-scan "$BUILD_DIR/make-scan" \
+    --seeds 1:11 --backgrounds plane,cylinder,sphere --out bench/results/detect
 fi
