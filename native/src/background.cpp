@@ -1,3 +1,4 @@
+#include "report_text.hpp"
 #include "relief_snake/background.hpp"
 #include "relief_snake/plane_fit.hpp"
 
@@ -452,7 +453,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     r.ring_max_residual = std::max(r.ring_max_residual, std::abs(r.height[v]));
   }
   r.ring_rms_residual = fitted ? std::sqrt(sum2 / static_cast<double>(fitted)) : 0.0;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.seconds = seconds_since(start);
   return r;
 }
 

@@ -1,3 +1,4 @@
+#include "report_text.hpp"
 #include "relief_snake/band.hpp"
 
 #include <algorithm>
@@ -15,13 +16,6 @@ namespace relief_snake {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
 
 // One ring's snake, as the outer contour's attempts: schedule, region side, evidence, verdict.
 struct RingRun {
@@ -331,7 +325,7 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
                                     "its walls rising away from the middle"
                                   : "a band: the relief lies between the two contours (contour and band_contour)");
   result.checks.push_back({"band_engraved", engraved ? 1.0 : 0.0});
-  result.checks.push_back({"seconds", std::chrono::duration<double>(Clock::now() - t_start).count()});
+  result.checks.push_back({"seconds", seconds_since(t_start)});
   return result;
 }
 

@@ -1,5 +1,6 @@
 // Automatic detection of reliefs: robust background, Otsu threshold, components, plateaus,
 // and the snake from each candidate's own outline (detect.hpp).
+#include "report_text.hpp"
 #include "relief_snake/detect.hpp"
 
 #include <algorithm>
@@ -19,13 +20,6 @@ namespace relief_snake {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
 
 /// Rings of the opening that removes a taller relief's wall from the lower plateau around it.
 constexpr int kOpeningRings = 3;
@@ -407,7 +401,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
         }
       }
       if (out.cancelled) break;
-      cand.refined.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+      cand.refined.seconds = seconds_since(t0);
     }
     candidates.push_back(std::move(cand));
   }
@@ -450,7 +444,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
   for (std::size_t c = 0; c < out.candidates.size(); ++c) out.candidates[c].refined = std::move(outcomes[c]);
   if (out.candidates.empty()) out.notes.push_back("no relief found: nothing stands clear of the background by more than " +
                                                   fmt(threshold) + " over an area of at least " + fmt(min_area));
-  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  out.seconds = seconds_since(start);
   return out;
 }
 

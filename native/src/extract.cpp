@@ -1,3 +1,4 @@
+#include "report_text.hpp"
 #include "relief_snake/extract.hpp"
 
 #include <chrono>
@@ -8,10 +9,6 @@
 namespace relief_snake {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 }  // namespace
 

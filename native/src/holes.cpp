@@ -1,3 +1,4 @@
+#include "report_text.hpp"
 #include "relief_snake/holes.hpp"
 
 #include <algorithm>
@@ -25,13 +26,6 @@ const char* to_string(HoleMode mode) { return mode == HoleMode::Off ? "off" : "a
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(3);
-  s << x;
-  return s.str();
-}
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -256,8 +250,8 @@ HoleRun run_hole(const Mesh& mesh, PlanarityField& planarity, const Options& opt
     if (!(o.area > 0) || inside < 0.9 * o.area || o.area > 0.8 * outer_area) {
       o.check.holds = false;
       o.check.score -= 10;
-      o.check.reasons.push_back("its contour leaves the relief (it encloses " + fmt(o.area) +
-                                " of area, " + fmt(outer_area > 0 ? o.area / outer_area : 0) + " of the region)");
+      o.check.reasons.push_back("its contour leaves the relief (it encloses " + fmt(o.area, 3) +
+                                " of area, " + fmt(outer_area > 0 ? o.area / outer_area : 0, 3) + " of the region)");
     }
     o.attempts = attempts;
     const bool holds = o.check.holds;
@@ -442,7 +436,7 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
       failed.check.holds = false;
       failed.check.reasons.push_back("its snake collapsed before it met a step (" +
                                      std::string(starts[k].from_picks ? "check the hole picks or h" :
-                                                 "an island of area " + fmt(starts[k].island_area) +
+                                                 "an island of area " + fmt(starts[k].island_area, 3) +
                                                      " stays in the relief") + ")");
       search.holes.push_back(std::move(failed));
       continue;
@@ -456,11 +450,11 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
   if (search.ignored_small > 0)
     search.notes.push_back(std::to_string(search.ignored_small) +
                            " low area(s) inside the relief (over 1 h^2) were below the minimum hole area (" +
-                           fmt(so.min_area) + " h^2) and were not taken as holes");
+                           fmt(so.min_area, 3) + " h^2) and were not taken as holes");
   if (search.ignored_no_rim > 0)
     search.notes.push_back(std::to_string(search.ignored_no_rim) +
                            " low area(s) inside the relief were not taken as holes (not down at the background, or no relief round them)");
-  search.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  search.seconds = seconds_since(t0);
   return search;
 }
 

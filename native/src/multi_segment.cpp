@@ -1,4 +1,5 @@
 // Several pick groups on one Segmenter, and the overlaps between their regions.
+#include "report_text.hpp"
 #include "relief_snake/multi_segment.hpp"
 
 #include <algorithm>
@@ -88,7 +89,7 @@ MultiResult segment_many(Segmenter& segmenter, const Mesh& mesh, const std::vect
     } catch (const Error& e) {
       outcome.error = e.what();
     }
-    outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    outcome.seconds = seconds_since(start);
     if (out.cancelled) break;
     out.reliefs.push_back(std::move(outcome));
   }

@@ -1,4 +1,5 @@
 // The evolution schedule: coarse, refinement (one or more spacings), stabilisation.
+#include "report_text.hpp"
 #include "relief_snake/schedule.hpp"
 
 #include <chrono>
@@ -11,10 +12,6 @@ namespace relief_snake {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // sigma of Eqn. 9: the spread of P^ along the initial contour, on the background.
 double background_sigma(const Mesh& mesh, PlanarityField& planarity, const std::vector<SurfacePoint>& start) {
   std::vector<int> corners;

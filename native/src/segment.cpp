@@ -1,3 +1,4 @@
+#include "report_text.hpp"
 #include "relief_snake/segment.hpp"
 
 #include <algorithm>
@@ -53,17 +54,6 @@ std::vector<std::pair<const char*, double>> DerivedParameters::named_values() co
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
-
 void validate_options(const Mesh& mesh, const Options& o) {
   const double h = o.step_height;
   if (h != kAuto) checked_step_height(h);
