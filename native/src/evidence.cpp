@@ -36,6 +36,23 @@ void gather_ball(const Mesh& mesh, int v0, const Vec3& centre, double radius, st
   }
 }
 
+// The longest run of consecutive set flags (a closed contour's runs wrap round), in flags,
+// and the index of its middle flag (-1 when none is set).
+struct Run {
+  int length = 0, middle = -1;
+};
+Run longest_run(const std::vector<char>& flags, bool closed) {
+  const int m = static_cast<int>(flags.size());
+  Run best;
+  int run = 0;
+  // Going round twice lets a run wrap; runs are capped at m.
+  for (int k = 0; k < (closed ? 2 * m : m); ++k) {
+    run = flags[k % m] ? std::min(run + 1, m) : 0;
+    if (run > best.length) best.length = run, best.middle = (k - run / 2) % m;
+  }
+  return best;
+}
+
 }  // namespace
 
 double region_area(const Mesh& mesh, const std::vector<char>& region) {
@@ -186,14 +203,9 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     for (int j = 0; j + 1 < n || (options.closed && j < n); ++j) length += (point_at(j + 1) - point_at(j)).norm();
     const double spacing = length / count;  // contour length per attempted profile
     const int m = static_cast<int>(evidence.profiles.size());
-    int run = 0, longest = 0;
-    // A closed contour's run may wrap: go round twice, runs capped at m.
-    for (int k = 0; k < (options.closed ? 2 * m : m); ++k) {
-      const StepProfile& p = evidence.profiles[k % m];
-      run = p.front_low ? std::min(run + 1, m) : 0;
-      longest = std::max(longest, run);
-    }
-    evidence.longest_front_low = longest * spacing;
+    std::vector<char> low_flags(m);
+    for (int k = 0; k < m; ++k) low_flags[k] = evidence.profiles[k].front_low;
+    evidence.longest_front_low = longest_run(low_flags, options.closed).length * spacing;
 
     // Offset from each point inwards to where the surface first reaches half the step.
     std::vector<double> offsets;
@@ -206,20 +218,15 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     }
     evidence.offset_median = quantile(offsets, 0.5);
     const double far = evidence.offset_median + std::max(options.offset_tolerance * h, 2 * edge);
-    int far_count = 0, longest_end = -1;
-    run = longest = 0;
-    for (int k = 0; k < (options.closed ? 2 * m : m); ++k) {
-      const bool is_far = evidence.profiles[k % m].offset > far;
-      if (k < m) far_count += is_far ? 1 : 0;
-      run = is_far ? std::min(run + 1, m) : 0;
-      if (run > longest) longest = run, longest_end = k;
-    }
-    if (longest > 0) evidence.far_point = evidence.profiles[(longest_end - longest / 2) % m].contour_index;
+    std::vector<char> far_flags(m);
+    for (int k = 0; k < m; ++k) far_flags[k] = evidence.profiles[k].offset > far;
+    const Run far_run = longest_run(far_flags, options.closed);
+    if (far_run.length > 0) evidence.far_point = evidence.profiles[far_run.middle].contour_index;
     evidence.offset_q90 = quantile(offsets, 0.9);
     evidence.offset_q75 = quantile(offsets, 0.75);
     evidence.offset_q95 = quantile(offsets, 0.95);
-    evidence.far_share = double(far_count) / m;
-    evidence.longest_far = longest * spacing;
+    evidence.far_share = double(std::count(far_flags.begin(), far_flags.end(), 1)) / m;
+    evidence.longest_far = far_run.length * spacing;
   }
   return evidence;
 }
