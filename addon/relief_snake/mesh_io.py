@@ -74,21 +74,14 @@ def live_mesh(obj):
 _LOOP_VERTEX_FORMAT = 'I' if bpy.app.version < (4, 0, 0) else 'i'
 
 
-def _as_int32(buf):
-    """array('i') with the same 4-byte values as `buf` (vertex indices are far below 2**31)."""
-    if buf.typecode == 'i':
-        return buf
-    out = array('i')
-    out.frombytes(buf.tobytes())
-    return out
-
-
 def read_buffers(mesh):
     """Vertices and triangles of a Mesh datablock (no modifiers).
 
-    Returns (vertices, triangles): vertices array('f') flat 3*#V (object space), triangles
-    array('i') flat 3*#T (loop triangles, so n-gons are triangulated the way Blender draws them).
-    An all-triangle mesh (every scan) reads its loops' vertices directly, in one block copy.
+    Returns (vertices, triangles): vertices array('f') flat 3*#V (object space), triangles flat
+    3*#T 4-byte ints (loop triangles, so n-gons are triangulated the way Blender draws them), in
+    the format Blender stores them: array('I') in 3.x, array('i') in 4.0+ (the engine takes both;
+    vertex indices are far below 2**31, and a conversion would copy the buffer once more). An
+    all-triangle mesh (every scan) reads its loops' vertices directly, in one block copy.
     """
     nv = len(mesh.vertices)
     vertices = array('f', bytes(12 * nv))
@@ -101,12 +94,12 @@ def read_buffers(mesh):
             corner_vert.data.foreach_get("value", triangles)
         else:
             mesh.loops.foreach_get("vertex_index", triangles)
-        return vertices, _as_int32(triangles)
+        return vertices, triangles
     mesh.calc_loop_triangles()
     nt = len(mesh.loop_triangles)
     triangles = array(_LOOP_VERTEX_FORMAT, bytes(12 * nt))
     mesh.loop_triangles.foreach_get("vertices", triangles)
-    return vertices, _as_int32(triangles)
+    return vertices, triangles
 
 
 def _selection_flags(mesh):

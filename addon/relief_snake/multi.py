@@ -227,8 +227,8 @@ class _ModalRun:
     first timer tick reads the mesh (after the status bar said so), a job.MeshJob runs the engine,
     later ticks show its progress, Esc cancels at once, and every step runs under try/finally so
     that the timer, the preview and the status text go away however the run ends. Subclasses
-    give _read(context) -> (obj, vertices, triangles, work, state), _status_text(snap) and
-    _finish(context, obj, doc)."""
+    give _read(context) -> (obj, vertices, triangles, work(mesh, progress), progress-bar total or
+    0), _status_text(snap) and _finish(context, obj, doc)."""
 
     running = None  # the operator whose run is going (shared by both operators: one at a time)
     _total = 0  # what the progress bar counts to (0: no bar)
