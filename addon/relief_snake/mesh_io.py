@@ -13,6 +13,7 @@ segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real w
 """
 
 import contextlib
+import math
 import operator
 import os
 import tempfile
@@ -148,26 +149,35 @@ def _edit_selection(obj):
     return selected, history, bm.verts
 
 
-def _history_file_dir():
-    """Where the click order's scratch .blend goes: memory-backed /dev/shm where there is one."""
+def _history_file_dirs():
+    """Where the click order's scratch .blend may go, in order: memory-backed /dev/shm where there
+    is one, then the system's temporary folder (None: tempfile's default)."""
     shm = "/dev/shm"
-    return shm if os.path.isdir(shm) and os.access(shm, os.W_OK) else None
+    return ([shm] if os.path.isdir(shm) and os.access(shm, os.W_OK) else []) + [None]
 
 
 def _stored_history(mesh):
     """The mesh's MSelect array [(index, type)] as stored, through a scratch .blend of the mesh
     alone (bpy.data.libraries.write: a block copy of its arrays, no bmesh) read back by
     blend_history. None if that could not be done (the caller reads it through bmesh)."""
-    fd, path = tempfile.mkstemp(prefix="relief-snake-", suffix=".blend", dir=_history_file_dir())
-    os.close(fd)
-    try:
-        bpy.data.libraries.write(path, {mesh}, compress=False)
-        return blend_history.read_select_history(path, "ME" + mesh.name)
-    except (blend_history.Unreadable, OSError, RuntimeError, TypeError, ValueError):
-        return None
-    finally:
-        with contextlib.suppress(OSError):
-            os.remove(path)
+    for folder in _history_file_dirs():
+        try:
+            fd, path = tempfile.mkstemp(prefix="relief-snake-", suffix=".blend", dir=folder)
+        except OSError:
+            continue
+        os.close(fd)
+        try:
+            try:
+                bpy.data.libraries.write(path, {mesh}, compress=False)
+            except (OSError, RuntimeError):  # e.g. a /dev/shm too small for the mesh: the next folder
+                continue
+            return blend_history.read_select_history(path, "ME" + mesh.name)
+        except (blend_history.Unreadable, OSError, TypeError, ValueError):
+            return None
+        finally:
+            with contextlib.suppress(OSError):
+                os.remove(path)
+    return None
 
 
 def _bmesh_history(mesh):
@@ -375,8 +385,9 @@ def write_curve(obj, contour, closed, radius=None, more_contours=()):
         # never thinner than its own point spacing: the refinement's half-edge spacing alone gave
         # a hairline that read as dashed over the Edit Mode mesh.
         n = len(contour)
-        length = sum(sum((contour[i][k] - contour[i - 1][k]) ** 2 for k in range(3)) ** 0.5 for i in range(1, n))
-        size = sum((max(p[k] for p in contour) - min(p[k] for p in contour)) ** 2 for k in range(3)) ** 0.5
+        length = sum(map(math.dist, contour[1:], contour[:-1]))  # in C: no Python frame per point
+        axes = list(zip(*contour))
+        size = math.dist([min(a) for a in axes], [max(a) for a in axes])
         radius = max(0.6 * length / max(1, n - 1), 0.006 * size)
     curve.bevel_depth = radius
     curve.bevel_resolution = 2

@@ -689,6 +689,20 @@ class ObjectModeClickOrder(AddonTestCase):
         self.obj.data.name = "Scan with a long name: " + "x" * 30
         self.assertEqual(self.history(), order)
 
+    def test_a_folder_that_cannot_be_written_is_skipped(self):
+        order = self.picks[:5]
+        select_vertices(self.obj, order)
+        io = addon().mesh_io
+        real = io._history_file_dirs
+        bmesh_real, calls = io._bmesh_history, []
+        io._history_file_dirs = lambda: ["/nonexistent/relief-snake"] + real()
+        io._bmesh_history = lambda mesh: calls.append(mesh) or bmesh_real(mesh)
+        try:
+            self.assertEqual(self.history(), order)
+        finally:
+            io._history_file_dirs, io._bmesh_history = real, bmesh_real
+        self.assertEqual(calls, [], "the next folder was not tried")
+
     def test_falls_back_to_bmesh_when_the_file_cannot_be_read(self):
         order = self.picks[:5]
         select_vertices(self.obj, order)
@@ -707,14 +721,16 @@ class ObjectModeClickOrder(AddonTestCase):
         select_vertices(self.obj, self.picks[:4])
         import glob
         import os
-        folder = addon().mesh_io._history_file_dir()
         import tempfile
-        folder = folder or tempfile.gettempdir()
-        before = set(glob.glob(os.path.join(folder, "relief-snake-*.blend")))
+        folders = [f or tempfile.gettempdir() for f in addon().mesh_io._history_file_dirs()]
+
+        def scratch():
+            return {p for f in folders for p in glob.glob(os.path.join(f, "relief-snake-*.blend"))}
+        before = scratch()
         names = [m.name for m in bpy.data.meshes]
         users, dirty = self.obj.data.users, bpy.data.is_dirty
         self.history()
-        self.assertEqual(set(glob.glob(os.path.join(folder, "relief-snake-*.blend"))), before)
+        self.assertEqual(scratch(), before)
         self.assertEqual([m.name for m in bpy.data.meshes], names)
         self.assertEqual((self.obj.data.users, bpy.data.is_dirty), (users, dirty))
 
