@@ -43,7 +43,8 @@ class Request:
     picks: list of vertex indices in order; step_height: h > 0, or None to let the engine
     estimate it; kwargs: the engine's keyword arguments (w_int, open_contour, relief_side,
     max_iterations, advanced options); key: what identifies the mesh in the cache (the object's
-    name); digest: fingerprint(vertices, triangles); read_seconds: time spent reading Blender data.
+    name); digest: fingerprint(vertices, triangles), computed on first use; read_seconds: time
+    spent reading Blender data.
     """
 
     def __init__(self, vertices, triangles, picks, step_height, kwargs, key=None, read_seconds=0.0):
@@ -52,9 +53,17 @@ class Request:
         self.step_height = step_height
         self.kwargs = dict(kwargs)
         self.key = key
-        self.digest = fingerprint(vertices, triangles)
+        self._digest = None
         self.read_seconds = read_seconds
         self.num_vertices = len(vertices) // 3
+
+    @property
+    def digest(self):
+        """fingerprint(vertices, triangles), computed on first use: by run_engine, so in an
+        interactive run the worker thread hashes the buffers, not Blender's main thread."""
+        if self._digest is None:
+            self._digest = fingerprint(self.vertices, self.triangles)
+        return self._digest
 
 
 class MeshCache:
@@ -305,22 +314,30 @@ class MeshJob(_WorkerJob):
     def __init__(self, core, vertices, triangles, work, key=None, cache=MESH_CACHE):
         super().__init__(core, cache)
         self.vertices, self.triangles, self.work, self.key = vertices, triangles, work, key
-        self.digest = fingerprint(vertices, triangles)
+        self._digest = None
         self.num_vertices = len(vertices) // 3
         self.mesh_cached = False
+
+    @property
+    def digest(self):
+        """fingerprint(vertices, triangles), computed on first use (in the worker, by _run)."""
+        if self._digest is None:
+            self._digest = fingerprint(self.vertices, self.triangles)
+        return self._digest
 
     def _group_progress(self, index, phase, iteration, snaxels, contour):
         return self._progress(phase, iteration, snaxels, contour, index)
 
     def _run(self):
         cache = self.cache if self.key else None
-        mesh = cache.get(self.key, self.digest) if cache is not None else None
+        digest = self.digest  # hashed here, off the main thread; mesh_changed() compares it once done
+        mesh = cache.get(self.key, digest) if cache is not None else None
         self.mesh_cached = mesh is not None
         if mesh is None:
             self._stage("intake")
             mesh = self.core.Mesh(self.vertices, self.triangles)
             if cache is not None:
-                cache.put(self.key, self.digest, mesh)
+                cache.put(self.key, digest, mesh)
         if self._cancel.is_set():
             raise self.core.Cancelled("cancelled during mesh intake")
         self._stage("segment")
