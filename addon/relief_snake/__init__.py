@@ -4,7 +4,7 @@ Select vertices around a relief in click order, set the step height, press Segme
 the relief vertices land in a vertex group and the outline in a curve object.
 Scripting: see the `api` submodule.
 
-Modules: pick_order, validation, summary and job know nothing of bpy (tested in plain
+Modules: pick_order, validation, summary, job and blend_history know nothing of bpy (tested in plain
 Python); mesh_io, api, units, properties, preview, operators and panel are the Blender side.
 """
 
@@ -18,7 +18,7 @@ bl_info = {
     "category": "Mesh",
 }
 
-_MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "mesh_io", "preview",
+_MODULES = ("pick_order", "validation", "summary", "job", "units", "properties", "blend_history", "mesh_io", "preview",
             "region_faces", "region_view", "api", "operators", "panel", "multi")
 
 if "bpy" in locals():  # script reload (F8 / reload scripts): refresh the submodules
@@ -54,9 +54,9 @@ def unregister():
     # A running worker is asked to stop; its result is dropped (it holds no Blender data).
     job.cancel_all(wait=2.0)
     job.MESH_CACHE.clear()
-    running = operators.MESH_OT_relief_snake_segment._modal
-    if running is not None:
-        running._cleanup(bpy.context)
+    for running in (operators.MESH_OT_relief_snake_segment._modal, multi._ModalRun.running):
+        if running is not None:
+            running._cleanup(bpy.context)
     preview.stop()
     region_view.stop()
     region_view.unregister_handlers()

@@ -160,7 +160,7 @@ def apply_result(obj, result, *, group_name="Relief", make_curve=True):
         raise EngineError("Give the vertex group a name")
     relief = result.get("relief_vertices", [])
     nv = mesh_io.live_vertex_count(obj)
-    if any(not 0 <= i < nv for i in relief):
+    if relief and (min(relief) < 0 or max(relief) >= nv):
         raise EngineError("The mesh changed while segmenting; nothing was written: run Segment again")
     contour = result.get("contour", [])
     mesh_io.write_vertex_group(obj, group_name, relief)

@@ -4,6 +4,7 @@ mesh cache, and the worker thread the interactive operator polls.
     request = Request(vertices, triangles, picks, step_height, kwargs)   # filled by api.prepare
     result = run_engine(core, request)                                     # blocking
     job = SegmentJob(core, request); job.start(); job.poll(); job.cancel() # worker thread
+    job = MeshJob(core, vertices, triangles, lambda mesh, progress: mesh.detect(progress=progress))
 
 Nothing here touches Blender data, so the worker thread may run it and plain Python can
 test it (tests/blender/test_job.py). Blender data is read before (api.prepare) and written
@@ -15,7 +16,7 @@ import threading
 import time
 
 __all__ = ["EngineError", "Request", "fingerprint", "MeshCache", "MESH_CACHE", "run_engine",
-           "SegmentJob", "active_jobs", "cancel_all"]
+           "SegmentJob", "MeshJob", "active_jobs", "cancel_all"]
 
 
 class EngineError(RuntimeError):
@@ -42,7 +43,8 @@ class Request:
     picks: list of vertex indices in order; step_height: h > 0, or None to let the engine
     estimate it; kwargs: the engine's keyword arguments (w_int, open_contour, relief_side,
     max_iterations, advanced options); key: what identifies the mesh in the cache (the object's
-    name); digest: fingerprint(vertices, triangles); read_seconds: time spent reading Blender data.
+    name); digest: fingerprint(vertices, triangles), computed on first use; read_seconds: time
+    spent reading Blender data.
     """
 
     def __init__(self, vertices, triangles, picks, step_height, kwargs, key=None, read_seconds=0.0):
@@ -51,9 +53,17 @@ class Request:
         self.step_height = step_height
         self.kwargs = dict(kwargs)
         self.key = key
-        self.digest = fingerprint(vertices, triangles)
+        self._digest = None
         self.read_seconds = read_seconds
         self.num_vertices = len(vertices) // 3
+
+    @property
+    def digest(self):
+        """fingerprint(vertices, triangles), computed on first use: by run_engine, so in an
+        interactive run the worker thread hashes the buffers, not Blender's main thread."""
+        if self._digest is None:
+            self._digest = fingerprint(self.vertices, self.triangles)
+        return self._digest
 
 
 class MeshCache:
@@ -160,13 +170,15 @@ class Snapshot:
     """The latest progress, copied for the main thread: stage ("intake", "segment" or the
     engine's phase name), iteration, points (snaxels), contour (list of (x, y, z) or None),
     contour_serial (counts contour updates, so the viewport rebuilds its batch only on change),
-    seconds since start."""
+    seconds since start, and index (the relief a MeshJob is on: the group, or the candidate)."""
 
-    __slots__ = ("stage", "iteration", "points", "contour", "contour_serial", "seconds")
+    __slots__ = ("stage", "iteration", "points", "contour", "contour_serial", "seconds", "index")
 
-    def __init__(self, stage="waiting", iteration=0, points=0, contour=None, contour_serial=0, seconds=0.0):
+    def __init__(self, stage="waiting", iteration=0, points=0, contour=None, contour_serial=0, seconds=0.0,
+                 index=0):
         self.stage, self.iteration, self.points = stage, iteration, points
         self.contour, self.contour_serial, self.seconds = contour, contour_serial, seconds
+        self.index = index
 
 
 _ACTIVE = set()
@@ -190,14 +202,15 @@ def cancel_all(wait=0.0):
     return [j for j in jobs if j.running]
 
 
-class SegmentJob:
-    """One segmentation in a worker thread. The main thread polls snapshot() and done, and
-    reads result / error / cancelled once done. cancel() only sets a flag and returns at once:
-    the engine stops at its next progress call; a job cancelled while in mesh intake finishes
-    intake first (intake has no progress callback) and its result is then discarded."""
+class _WorkerJob:
+    """One engine call in a worker thread. The main thread polls snapshot() and done, and reads
+    result / error / cancelled once done. cancel() only sets a flag and returns at once: the
+    engine stops at its next progress call; a job cancelled while in mesh intake finishes intake
+    first (intake has no progress callback) and its result is then discarded. Subclasses give
+    _run() (the work, in the worker)."""
 
-    def __init__(self, core, request, cache=MESH_CACHE):
-        self.core, self.request, self.cache = core, request, cache
+    def __init__(self, core, cache=MESH_CACHE):
+        self.core, self.cache = core, cache
         self.result = None
         self.error = None
         self.cancelled = False
@@ -213,21 +226,28 @@ class SegmentJob:
         with self._lock:
             self._snap.stage = name
 
-    def _progress(self, phase, iteration, snaxels, contour):
+    def _progress(self, phase, iteration, snaxels, contour, index=None):
         with self._lock:
             s = self._snap
             s.stage, s.iteration, s.points = phase, iteration, snaxels
+            if index is not None:
+                s.index = index
             if contour is not None:  # the engine sends it at most every 0.1 s
                 s.contour = contour
                 s.contour_serial += 1
         return not self._cancel.is_set()
 
+    def _run(self):
+        raise NotImplementedError
+
     def _work(self):
         try:
-            self.result = run_engine(self.core, self.request, self._progress, self.cache, self._stage)
+            self.result = self._run()
         except self.core.Cancelled:
             self.cancelled = True
         except EngineError as exc:
+            self.error = str(exc)
+        except self.core.Error as exc:
             self.error = str(exc)
         except Exception as exc:  # keep the UI alive: report it instead of a silent thread death
             self.error = "Relief Snake failed: %s: %s" % (type(exc).__name__, exc)
@@ -269,4 +289,56 @@ class SegmentJob:
         with self._lock:
             s = self._snap
             return Snapshot(s.stage, s.iteration, s.points, s.contour, s.contour_serial,
-                            time.perf_counter() - (self._t0 or time.perf_counter()))
+                            time.perf_counter() - (self._t0 or time.perf_counter()), s.index)
+
+
+class SegmentJob(_WorkerJob):
+    """One segmentation (run_engine on a Request) in a worker thread."""
+
+    def __init__(self, core, request, cache=MESH_CACHE):
+        super().__init__(core, cache)
+        self.request = request
+
+    def _run(self):
+        return run_engine(self.core, self.request, self._progress, self.cache, self._stage)
+
+
+class MeshJob(_WorkerJob):
+    """Several reliefs in one engine call in a worker thread: the engine Mesh of (vertices,
+    triangles) is taken from the cache or built there (intake off the main thread too), then
+    work(mesh, progress) runs, e.g. lambda mesh, progress: mesh.detect(progress=progress).
+    progress(index, phase, iteration, snaxels, contour) is the engine's group progress; the
+    snapshot's index is the relief being segmented. digest: fingerprint(vertices, triangles),
+    to check before writing that the mesh did not change meanwhile."""
+
+    def __init__(self, core, vertices, triangles, work, key=None, cache=MESH_CACHE):
+        super().__init__(core, cache)
+        self.vertices, self.triangles, self.work, self.key = vertices, triangles, work, key
+        self._digest = None
+        self.num_vertices = len(vertices) // 3
+        self.mesh_cached = False
+
+    @property
+    def digest(self):
+        """fingerprint(vertices, triangles), computed on first use (in the worker, by _run)."""
+        if self._digest is None:
+            self._digest = fingerprint(self.vertices, self.triangles)
+        return self._digest
+
+    def _group_progress(self, index, phase, iteration, snaxels, contour):
+        return self._progress(phase, iteration, snaxels, contour, index)
+
+    def _run(self):
+        cache = self.cache if self.key else None
+        digest = self.digest  # hashed here, off the main thread; mesh_changed() compares it once done
+        mesh = cache.get(self.key, digest) if cache is not None else None
+        self.mesh_cached = mesh is not None
+        if mesh is None:
+            self._stage("intake")
+            mesh = self.core.Mesh(self.vertices, self.triangles)
+            if cache is not None:
+                cache.put(self.key, digest, mesh)
+        if self._cancel.is_set():
+            raise self.core.Cancelled("cancelled during mesh intake")
+        self._stage("segment")
+        return self.work(mesh, self._group_progress)

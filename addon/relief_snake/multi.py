@@ -10,12 +10,17 @@ Each vertex group whose name starts with the prefix is one relief's picks; a ver
 click order, so its vertices are ordered by angle around their centroid (pick_order). Results are
 written like a normal segmentation: a vertex group per relief ("Relief" + what follows the prefix,
 e.g. "Picks.Lion" -> "Relief.Lion") and an outline curve "<obj>_<group>Contour" per relief.
-The operators run synchronously (the UI waits; detect on 100k triangles takes a few seconds).
+Both operators run like Segment: synchronously from execute() (scripts, EXEC_DEFAULT, background
+mode), and as modal operators from invoke() in a window: the mesh is read on the main thread, the
+engine (mesh intake included) runs in a job.MeshJob worker, a timer shows its progress in the
+status bar and the evolving outline in the viewport, and Esc cancels. Nothing is written before
+the engine is done, so a cancel or a failure leaves the scene as it was. One interactive run at a
+time, Segment's included.
 """
 
 import bpy
 
-from . import api, mesh_io, pick_order
+from . import api, job, mesh_io, pick_order, preview, properties, summary
 from .job import MESH_CACHE, EngineError, fingerprint
 
 __all__ = ["groups_from_vertex_groups", "segment_vertex_groups", "detect_object", "apply_candidates",
@@ -25,13 +30,20 @@ __all__ = ["groups_from_vertex_groups", "segment_vertex_groups", "detect_object"
 DETECTIONS = {}
 
 
+def _read_mesh(obj):
+    """(vertices, triangles) of what the user sees of obj now (Edit Mode: the edit mesh)."""
+    api._mesh_object(obj)
+    with mesh_io.live_mesh(obj) as live:
+        vertices, triangles = mesh_io.read_buffers(live)
+    if not triangles:
+        raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
+    return vertices, triangles
+
+
 def _engine_mesh(obj):
     """The engine Mesh for obj's data (through the add-on's cache, like a normal segmentation)."""
     core = api.load_core()
-    mesh_io.sync_edit_mode(obj)
-    vertices, triangles = mesh_io.read_buffers(obj.data)
-    if not triangles:
-        raise EngineError("The mesh %r has no faces: Relief Snake needs a triangle/polygon surface" % obj.name)
+    vertices, triangles = _read_mesh(obj)
     digest = fingerprint(vertices, triangles)
     mesh = MESH_CACHE.get(obj.name_full, digest)
     if mesh is None:
@@ -106,20 +118,20 @@ def _result_names(names, prefix, result_prefix):
     return out
 
 
-def segment_vertex_groups(obj, prefix="Picks", step_height=None, *, result_prefix="Relief", write=True,
-                          options=None):
-    """Segment one relief per vertex group named prefix*, in one call (one Segmenter: the
-    planarity is reused between reliefs of the same h). Returns the "relief-snake-results/1"
-    document with "names" (the pick groups) and "written" (the result groups). Reliefs that could
-    not run ("failed") are not written; overlapping ones are written and marked doubtful."""
-    groups = groups_from_vertex_groups(obj, prefix)
-    core, mesh = _engine_mesh(obj)
+def _segment_many(mesh, groups, step_height, options=None, progress=None):
+    """The engine's segment_many over [(group name, picks)]; raises EngineError on its errors
+    (relief_snake_core.Cancelled passes through)."""
+    core = api.load_core()
     try:
-        doc = mesh.segment_many([p for _, p in groups], step_height, **(options or {}))
+        return mesh.segment_many([p for _, p in groups], step_height, progress=progress, **(options or {}))
     except core.Error as exc:
         raise EngineError(str(exc)) from None
-    names = [n for n, _ in groups]
-    doc["names"] = names
+
+
+def _write_groups(obj, doc, names, prefix, result_prefix="Relief", write=True):
+    """Name and (write=True) write the reliefs of a segment_many document: "names" (the pick
+    groups) and "written" (the result groups) are added to it. Failed reliefs are not written."""
+    doc["names"] = list(names)
     doc["written"] = []
     if write:
         for name, result in zip(_result_names(names, prefix, result_prefix), doc["reliefs"]):
@@ -130,15 +142,32 @@ def segment_vertex_groups(obj, prefix="Picks", step_height=None, *, result_prefi
     return doc
 
 
+def segment_vertex_groups(obj, prefix="Picks", step_height=None, *, result_prefix="Relief", write=True,
+                          options=None):
+    """Segment one relief per vertex group named prefix*, in one call (one Segmenter: the
+    planarity is reused between reliefs of the same h). Returns the "relief-snake-results/1"
+    document with "names" (the pick groups) and "written" (the result groups). Reliefs that could
+    not run ("failed") are not written; overlapping ones are written and marked doubtful."""
+    groups = groups_from_vertex_groups(obj, prefix)
+    _, mesh = _engine_mesh(obj)
+    doc = _segment_many(mesh, groups, step_height, options)
+    return _write_groups(obj, doc, [n for n, _ in groups], prefix, result_prefix, write)
+
+
+def _detect(mesh, region_vertices=None, min_area=None, refine=True, options=None, progress=None):
+    core = api.load_core()
+    try:
+        return mesh.detect(region_vertices, min_area=min_area, refine=refine, progress=progress, **(options or {}))
+    except core.Error as exc:
+        raise EngineError(str(exc)) from None
+
+
 def detect_object(obj, *, region_vertices=None, min_area=None, refine=True, options=None):
     """Propose the reliefs of obj (relief_snake_core.Mesh.detect); writes nothing. The document
     is kept for the candidate list (DETECTIONS)."""
     api._mesh_object(obj)
-    core, mesh = _engine_mesh(obj)
-    try:
-        doc = mesh.detect(region_vertices, min_area=min_area, refine=refine, **(options or {}))
-    except core.Error as exc:
-        raise EngineError(str(exc)) from None
+    _, mesh = _engine_mesh(obj)
+    doc = _detect(mesh, region_vertices, min_area, refine, options)
     DETECTIONS[obj.name_full] = doc
     return doc
 
@@ -187,7 +216,155 @@ def _report_error(op, exc):
     return {'CANCELLED'}
 
 
-class MESH_OT_relief_snake_segment_groups(bpy.types.Operator):
+def busy():
+    """The interactive run in progress (Segment's, or one of the operators here), or None."""
+    from . import operators
+    return _ModalRun.running or operators.MESH_OT_relief_snake_segment._modal
+
+
+class _ModalRun:
+    """The interactive run of Detect and Segment Pick Groups, like Segment's (operators.py): the
+    first timer tick reads the mesh (after the status bar said so), a job.MeshJob runs the engine,
+    later ticks show its progress, Esc cancels at once, and every step runs under try/finally so
+    that the timer, the preview and the status text go away however the run ends. Subclasses
+    give _read(context) -> (obj, vertices, triangles, work(mesh, progress), progress-bar total or
+    0), _status_text(snap) and _finish(context, obj, doc)."""
+
+    running = None  # the operator whose run is going (shared by both operators: one at a time)
+    _total = 0  # what the progress bar counts to (0: no bar)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        return self._invoke_modal(context)
+
+    def _invoke_modal(self, context):
+        if busy() is not None:
+            self.report({'ERROR'}, "Relief Snake is already running: wait for it or press Esc")
+            return {'CANCELLED'}
+        self._job = None
+        self._obj_name = None
+        self._shown_serial = -1
+        self._progress_on = False
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.05, window=context.window)
+        wm.modal_handler_add(self)
+        _ModalRun.running = self
+        self._status(context, "Relief Snake: reading mesh... (Esc cancels)")
+        return {'RUNNING_MODAL'}
+
+    def _status(self, context, text):
+        if context.workspace is not None:
+            context.workspace.status_text_set(text)
+
+    def _cleanup(self, context):
+        wm = context.window_manager
+        if getattr(self, "_timer", None) is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        if getattr(self, "_progress_on", False):
+            wm.progress_end()
+            self._progress_on = False
+        preview.stop()
+        self._status(context, None)
+        if _ModalRun.running is self:
+            _ModalRun.running = None
+        _redraw_views(context)
+
+    def modal(self, context, event):
+        running = False
+        try:
+            ret = self._modal_step(context, event)
+            running = 'RUNNING_MODAL' in ret or 'PASS_THROUGH' in ret
+            return ret
+        except Exception as exc:  # never leave a timer, a preview or "already running" behind
+            if self._job is not None:
+                self._job.cancel()
+            self.report({'ERROR'}, "Relief Snake failed: %s: %s" % (type(exc).__name__, exc))
+            return {'CANCELLED'}
+        finally:
+            if not running:
+                self._cleanup(context)
+
+    def cancel(self, context):
+        # Blender ends the modal operator (a file is loaded, the window closes): the worker is
+        # asked to stop and winds down in the background; its result is dropped.
+        if getattr(self, "_job", None) is not None:
+            self._job.cancel()
+        self._cleanup(context)
+
+    def _start(self, context):
+        obj, vertices, triangles, work, total = self._read(context)
+        self._obj_name, self._total = obj.name, total
+        self._job = job.MeshJob(api.load_core(), vertices, triangles, work, key=obj.name_full).start()
+        prefs = properties.preferences(context)
+        if prefs is not None:
+            preview.set_style(prefs.preview_color, prefs.preview_width)
+        preview.start()
+        if total:
+            context.window_manager.progress_begin(0, total)
+            self._progress_on = True
+
+    def _modal_step(self, context, event):
+        if event.type == 'ESC' and event.value == 'PRESS':
+            if self._job is not None:
+                self._job.cancel()  # the worker stops at its next progress call; its result is dropped
+            self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
+            return {'CANCELLED'}
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}  # keep navigating the view while it runs
+        if self._job is None:
+            try:
+                self._start(context)
+            except EngineError as exc:
+                self.report({'ERROR'}, str(exc))
+                return {'CANCELLED'}
+            return {'RUNNING_MODAL'}
+        obj = bpy.data.objects.get(self._obj_name)
+        run = self._job
+        if not run.done:
+            snap = run.snapshot()
+            if snap.contour is not None and obj is not None and snap.contour_serial != self._shown_serial:
+                preview.set_contour(snap.contour, obj.matrix_world, True)
+                self._shown_serial = snap.contour_serial
+            if self._progress_on:
+                context.window_manager.progress_update(min(snap.index, self._total))
+            self._status(context, "Relief Snake: %s (Esc cancels)" % self._status_text(snap))
+            _redraw_views(context)
+            return {'RUNNING_MODAL'}
+        if run.cancelled:
+            self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
+            return {'CANCELLED'}
+        if run.error:
+            self.report({'ERROR'}, run.error)
+            return {'CANCELLED'}
+        if obj is None or obj.type != 'MESH':
+            self.report({'ERROR'}, "The object was removed while the engine ran; nothing was written")
+            return {'CANCELLED'}
+        # PASS_THROUGH let the user edit or undo meanwhile: use the result only on the mesh it was made for.
+        if api.mesh_changed(obj, run):
+            self.report({'ERROR'}, "The mesh changed while the engine ran; nothing was written: run it again")
+            return {'CANCELLED'}
+        try:
+            return self._finish(context, obj, run.result)
+        except EngineError as exc:
+            self.report({'ERROR'}, str(exc))
+            return {'CANCELLED'}
+
+
+def _phase_text(snap):
+    words = summary.PHASE_WORDS.get(snap.stage, snap.stage)
+    if snap.stage in ("intake", "segment", "waiting"):
+        return "%s, %.0f s" % (words, snap.seconds)
+    return "%s, step %d, %d points" % (words, snap.iteration, snap.points)
+
+
+def _step_height(context):
+    settings = context.scene.relief_snake
+    return None if getattr(settings, "estimate_step_height", True) else settings.step_height
+
+
+class MESH_OT_relief_snake_segment_groups(_ModalRun, bpy.types.Operator):
     """Segment one relief per vertex group whose name starts with the prefix (its vertices are the picks)"""
     bl_idname = "mesh.relief_snake_segment_groups"
     bl_label = "Segment Pick Groups"
@@ -200,21 +377,44 @@ class MESH_OT_relief_snake_segment_groups(bpy.types.Operator):
     def poll(cls, context):
         return context.active_object is not None and context.active_object.type == 'MESH'
 
-    def execute(self, context):
-        settings = context.scene.relief_snake
-        h = None if getattr(settings, "estimate_step_height", True) else settings.step_height
-        try:
-            doc = segment_vertex_groups(context.active_object, self.prefix, h)
-        except EngineError as exc:
-            return _report_error(self, exc)
+    def _report_done(self, doc):
         bad = [n for n, r in zip(doc["names"], doc["reliefs"]) if r["status"] != "converged"]
         self.report({'WARNING'} if bad else {'INFO'},
                     "%d reliefs written (%s)%s" % (len(doc["written"]), ", ".join(doc["written"]),
                                                    "; check: " + ", ".join(bad) if bad else ""))
         return {'FINISHED'}
 
+    def execute(self, context):
+        try:
+            doc = segment_vertex_groups(context.active_object, self.prefix, _step_height(context))
+        except EngineError as exc:
+            return _report_error(self, exc)
+        return self._report_done(doc)
 
-class MESH_OT_relief_snake_detect(bpy.types.Operator):
+    # -- interactive (_ModalRun) ---------------------------------------------------------------
+    def _read(self, context):
+        obj = context.active_object
+        groups = groups_from_vertex_groups(obj, self.prefix)
+        vertices, triangles = _read_mesh(obj)
+        self._groups = groups
+        h = _step_height(context)
+        options = {}
+        return obj, vertices, triangles, lambda mesh, progress: _segment_many(mesh, groups, h, options, progress), \
+            len(groups)
+
+    def _status_text(self, snap):
+        names = [n for n, _ in self._groups]
+        if snap.stage in ("intake", "segment", "waiting"):
+            return _phase_text(snap)
+        k = min(snap.index, len(names) - 1)
+        return "relief %d of %d (%s): %s" % (k + 1, len(names), names[k], _phase_text(snap))
+
+    def _finish(self, context, obj, doc):
+        _write_groups(obj, doc, [n for n, _ in self._groups], self.prefix)
+        return self._report_done(doc)
+
+
+class MESH_OT_relief_snake_detect(_ModalRun, bpy.types.Operator):
     """Propose the reliefs of the active mesh without picks; accept or reject them in the list"""
     bl_idname = "mesh.relief_snake_detect"
     bl_label = "Detect Reliefs"
@@ -223,14 +423,43 @@ class MESH_OT_relief_snake_detect(bpy.types.Operator):
     def poll(cls, context):
         return context.active_object is not None and context.active_object.type == 'MESH'
 
+    def _report_done(self, context, doc):
+        _fill_list(context, doc)
+        self.report({'INFO'}, "%d candidates found" % len(doc["candidates"]))
+        return {'FINISHED'}
+
     def execute(self, context):
         try:
             doc = detect_object(context.active_object)
         except EngineError as exc:
             return _report_error(self, exc)
-        _fill_list(context, doc)
-        self.report({'INFO'}, "%d candidates found" % len(doc["candidates"]))
-        return {'FINISHED'}
+        return self._report_done(context, doc)
+
+    # -- interactive (_ModalRun) ---------------------------------------------------------------
+    def _read(self, context):
+        obj = context.active_object
+        vertices, triangles = _read_mesh(obj)
+        return obj, vertices, triangles, lambda mesh, progress: _detect(mesh, progress=progress), 0
+
+    def _status_text(self, snap):
+        if snap.stage in ("intake", "waiting"):
+            return _phase_text(snap)
+        if snap.stage == "segment":  # the background fit and the components: no progress calls
+            return "finding candidates, %.0f s" % snap.seconds
+        return "candidate %d: %s" % (snap.index + 1, _phase_text(snap))
+
+    def _finish(self, context, obj, doc):
+        DETECTIONS[obj.name_full] = doc
+        return self._report_done(context, doc)
+
+
+def _redraw_views(context):
+    screen = context.screen
+    if screen is None:
+        return
+    for area in screen.areas:
+        if area.type == 'VIEW_3D':
+            area.tag_redraw()
 
 
 class MESH_OT_relief_snake_apply_candidates(bpy.types.Operator):

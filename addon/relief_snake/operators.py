@@ -111,7 +111,11 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
     def invoke(self, context, event):
         if bpy.app.background or context.window is None:
             return self.execute(context)
-        if MESH_OT_relief_snake_segment._modal is not None:
+        return self._invoke_modal(context)
+
+    def _invoke_modal(self, context):
+        from . import multi  # Detect and Segment Pick Groups run the same way: one run at a time
+        if multi.busy() is not None:
             self.report({'ERROR'}, "Relief Snake is already running: wait for it or press Esc")
             return {'CANCELLED'}
         self._fill_from_scene(context)

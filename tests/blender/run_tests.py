@@ -107,7 +107,8 @@ def main():
 
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()
-    for name in ("test_pick_order", "test_validation", "test_summary", "test_job", "test_placement", "test_region_faces",
+    for name in ("test_pick_order", "test_validation", "test_summary", "test_job", "test_blend_history", "test_placement",
+                 "test_region_faces",
                  "test_addon",
                  "test_extraction"):
         suite.addTests(loader.loadTestsFromName(name))

@@ -588,6 +588,159 @@ class PickOrder(AddonTestCase):
         self.assertIn("2 of %d" % len(self.picks), info)
 
 
+def _bmesh_click_order(mesh):
+    """The Object Mode click order the slow way: a bmesh copy of the whole mesh."""
+    bm = bmesh.new()
+    try:
+        bm.from_mesh(mesh)
+        return [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
+    finally:
+        bm.free()
+
+
+class ObjectModeClickOrder(AddonTestCase):
+    """Object Mode reads the click order (the mesh's MSelect array) from a scratch .blend of the mesh
+    (mesh_io._stored_history) instead of a bmesh copy. It is read again on every Segment (no cache),
+    so it must equal bmesh's reading for any history and follow every change of it."""
+
+    def history(self):
+        return addon().mesh_io.read_selection(self.obj)[1]
+
+    def set_history(self, order, selected=None, extra=()):
+        """Select `selected` (default: order) and store `order` (plus `extra` elements, e.g. a face)
+        as the history, through bmesh.to_mesh as a script would."""
+        mesh = self.obj.data
+        bm = bmesh.new()
+        bm.from_mesh(mesh)
+        for seq in (bm.verts, bm.edges, bm.faces):
+            seq.ensure_lookup_table()
+            for e in seq:
+                e.select = False
+        bm.select_history.clear()
+        for i in (order if selected is None else selected):
+            bm.verts[i].select = True
+        for i in order:
+            bm.select_history.add(bm.verts[i])
+        for e in extra:
+            e = bm.faces[e[1]] if e[0] == 'FACE' else bm.verts[e[1]]
+            e.select = True
+            bm.select_history.add(e)
+        bm.to_mesh(mesh)
+        bm.free()
+        mesh.update()
+
+    def test_read_without_bmesh_and_the_same_as_bmesh(self):
+        rng = random.Random(11)
+        nv = len(self.obj.data.vertices)
+        calls = []
+        real = addon().mesh_io._bmesh_history
+        addon().mesh_io._bmesh_history = lambda mesh: calls.append(mesh) or real(mesh)
+        try:
+            for trial in range(6):
+                order = rng.sample(range(nv), rng.randint(1, 12))
+                selected = order[:-2] if trial % 2 and len(order) > 3 else order  # unselected history entries
+                extra = [('FACE', rng.randrange(len(self.obj.data.polygons)))] if trial % 3 == 0 else []
+                self.set_history(order, selected, extra)
+                got = self.history()
+                self.assertEqual(got, _bmesh_click_order(self.obj.data), trial)
+                self.assertEqual(got, [i for i in order if i in set(selected)], trial)
+        finally:
+            addon().mesh_io._bmesh_history = real
+        self.assertEqual(calls, [], "the .blend route failed and bmesh was used")
+
+    def test_a_new_order_of_the_same_selection_is_seen(self):
+        # What no cache keyed by the mesh and its selection could see: the same vertices picked
+        # again in another order (Edit Mode and back, the usual way, and by a script).
+        order = self.picks[:6]
+        select_vertices(self.obj, order)
+        self.assertEqual(self.history(), order)
+        bpy.context.view_layer.objects.active = self.obj
+        bpy.ops.object.mode_set(mode='EDIT')
+        select_vertices(self.obj, order[::-1])
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertEqual(self.history(), order[::-1])
+        self.set_history(order[2:] + order[:2])
+        self.assertEqual(self.history(), order[2:] + order[:2])
+
+    def test_selection_and_mesh_changes_are_seen(self):
+        order = self.picks[:5]
+        select_vertices(self.obj, order)
+        self.assertEqual(self.history(), order)
+        # Deselected (as in the UI: the select flag goes, the history entry may stay): not in the order.
+        self.obj.data.vertices[order[1]].select = False
+        self.assertEqual(self.history(), [order[0]] + order[2:])
+        self.obj.data.vertices[order[1]].select = True
+        # A vertex added to the history (a sixth pick).
+        self.set_history(order + [self.picks[5]])
+        self.assertEqual(self.history(), order + [self.picks[5]])
+        # The mesh changes (a vertex moves; a group and weights add a block per vertex to the file).
+        self.obj.data.vertices[order[0]].co.z += 0.5
+        g = self.obj.vertex_groups.new(name="Weights")
+        g.add(list(range(0, len(self.obj.data.vertices), 2)), 0.5, 'REPLACE')
+        self.assertEqual(self.history(), order + [self.picks[5]])
+        self.assertEqual(self.history(), _bmesh_click_order(self.obj.data))
+        # An empty history with a selection: nothing, and the operator falls back to angles.
+        self.set_history([], selected=order)
+        self.assertEqual(self.history(), [])
+
+    def test_a_renamed_or_long_named_mesh(self):
+        order = self.picks[:4]
+        select_vertices(self.obj, order)
+        self.obj.data.name = "Scan with a long name: " + "x" * 30
+        self.assertEqual(self.history(), order)
+
+    def test_a_folder_that_cannot_be_written_is_skipped(self):
+        order = self.picks[:5]
+        select_vertices(self.obj, order)
+        io = addon().mesh_io
+        real = io._history_file_dirs
+        bmesh_real, calls = io._bmesh_history, []
+        io._history_file_dirs = lambda: ["/nonexistent/relief-snake"] + real()
+        io._bmesh_history = lambda mesh: calls.append(mesh) or bmesh_real(mesh)
+        try:
+            self.assertEqual(self.history(), order)
+        finally:
+            io._history_file_dirs, io._bmesh_history = real, bmesh_real
+        self.assertEqual(calls, [], "the next folder was not tried")
+
+    def test_falls_back_to_bmesh_when_the_file_cannot_be_read(self):
+        order = self.picks[:5]
+        select_vertices(self.obj, order)
+        blend = addon().blend_history
+        real = blend.read_select_history
+
+        def broken(path, name):
+            raise blend.Unreadable("a layout this reader does not know")
+        blend.read_select_history = broken
+        try:
+            self.assertEqual(self.history(), order)
+        finally:
+            blend.read_select_history = real
+
+    def test_the_scratch_file_leaves_no_trace(self):
+        select_vertices(self.obj, self.picks[:4])
+        import glob
+        import os
+        import tempfile
+        folders = [f or tempfile.gettempdir() for f in addon().mesh_io._history_file_dirs()]
+
+        def scratch():
+            return {p for f in folders for p in glob.glob(os.path.join(f, "relief-snake-*.blend"))}
+        before = scratch()
+        names = [m.name for m in bpy.data.meshes]
+        users, dirty = self.obj.data.users, bpy.data.is_dirty
+        self.history()
+        self.assertEqual(scratch(), before)
+        self.assertEqual([m.name for m in bpy.data.meshes], names)
+        self.assertEqual((self.obj.data.users, bpy.data.is_dirty), (users, dirty))
+
+    def test_operator_in_object_mode_uses_the_click_order(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj)
+        self.assertEqual(self.history(), self.picks)  # the group and curve written did not disturb it
+
+
 class MeasureAndApi(AddonTestCase):
     def test_measure_sets_the_step_height(self):
         a, b = self.picks[0], self.truth["relief_vertices"][0]
@@ -990,3 +1143,234 @@ class SeveralReliefs(AddonTestCase):
         with self.assertRaisesRegex(addon().job.EngineError, "at least 3"):
             addon().multi.segment_vertex_groups(obj, "Picks")
         self.assertEqual([x.name for x in obj.vertex_groups], ["Picks1"])
+
+
+class _WindowRecorder(_Recorder):
+    """A _Recorder that also takes a timer and a modal handler, and keeps every status text."""
+
+    def __init__(self):
+        super().__init__()
+        self.statuses = []
+
+    def event_timer_add(self, seconds, window=None):
+        self.calls.append(("timer_add", seconds))
+        return "the timer"
+
+    def modal_handler_add(self, op):
+        self.calls.append(("modal_handler_add",))
+
+    def status_text_set(self, text):
+        super().status_text_set(text)
+        self.statuses.append(text)
+
+
+class _WindowContext(_Context):
+    window = "a window"
+
+
+class SeveralReliefsModal(AddonTestCase):
+    """Detect and Segment Pick Groups run interactively like Segment: invoke -> timer ticks -> the
+    engine in a worker -> the result written on the main thread; Esc cancels and changes nothing.
+    Driven headless through the operators' own methods on a stand-in (as ModalPath does)."""
+
+    METHODS = ("_invoke_modal", "modal", "_modal_step", "_start", "_cleanup", "_status", "cancel", "_read",
+               "_status_text", "_finish", "_report_done")
+
+    def setUp(self):
+        super().setUp()
+        self.plate = make_scan_object("Plate", _plate())
+        bpy.context.view_layer.objects.active = self.plate
+        self.plate.select_set(True)
+        bpy.context.scene.relief_snake_candidates.clear()
+        addon().multi.DETECTIONS.clear()
+
+    def tearDown(self):
+        addon().multi._ModalRun.running = None
+        addon().operators.MESH_OT_relief_snake_segment._modal = None
+        super().tearDown()
+
+    def make_operator(self, cls, **attrs):
+        reports = []
+
+        class Stand_in:
+            _job = None
+            _obj_name = None
+            _shown_serial = -1
+            _timer = None
+            _progress_on = False
+
+            def report(self, kind, text):
+                reports.append((set(kind), text))
+
+        for name in self.METHODS:
+            setattr(Stand_in, name, getattr(cls, name))
+        op = Stand_in()
+        for k, v in attrs.items():
+            setattr(op, k, v)
+        return op, reports
+
+    def start(self, cls, **attrs):
+        op, reports = self.make_operator(cls, **attrs)
+        recorder = _WindowRecorder()
+        context = _WindowContext(recorder)
+        self.assertEqual(op._invoke_modal(context), {'RUNNING_MODAL'}, reports)
+        self.assertIs(addon().multi.busy(), op)
+        self.assertEqual(recorder.status, "Relief Snake: reading mesh... (Esc cancels)")  # before any read
+        self.assertIsNone(op._job)
+        return op, reports, recorder, context
+
+    def tick_until_done(self, op, context, limit=12000):
+        for _ in range(limit):
+            ret = op.modal(context, _Event('TIMER'))
+            if 'RUNNING_MODAL' not in ret:
+                return ret
+            time.sleep(0.01)
+        self.fail("the modal run did not end")
+
+    def assertCleanedUp(self, op, recorder):
+        self.assertIn(("timer_remove", "the timer"), recorder.calls)
+        self.assertIsNone(op._timer)
+        self.assertIsNone(addon().multi.busy(), "a later run would say 'already running'")
+        self.assertIsNone(recorder.status)
+        self.assertFalse(op._progress_on)
+
+    def pick_groups(self):
+        """Picks.A and Picks.B: the outline picks of two separate reliefs (detect without the snake)."""
+        doc = addon().multi.detect_object(self.plate, refine=False)
+        addon().multi.DETECTIONS.clear()
+        separate = [c for c in doc["candidates"] if c["detection"]["plateau"] == 0][:2]
+        self.assertEqual(len(separate), 2)
+        for name, c in zip(("Picks.A", "Picks.B"), separate):
+            g = self.plate.vertex_groups.new(name=name)
+            g.add(list(reversed(c["parameters"]["picks"])), 1.0, 'REPLACE')
+        bpy.context.scene.relief_snake.estimate_step_height = True
+
+    def test_detect_runs_in_a_worker_and_fills_the_list(self):
+        cls = addon().multi.MESH_OT_relief_snake_detect
+        op, reports, recorder, context = self.start(cls)
+        self.assertEqual(op.modal(context, _Event('MOUSEMOVE')), {'PASS_THROUGH'})  # the view stays usable
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})  # reads, starts the worker
+        self.assertTrue(op._job.running or op._job.done)
+        self.assertEqual(len(bpy.context.scene.relief_snake_candidates), 0)  # nothing before the end
+        ret = self.tick_until_done(op, context)
+        self.assertEqual(ret, {'FINISHED'}, reports)
+        self.assertCleanedUp(op, recorder)
+        doc = addon().multi.DETECTIONS[self.plate.name_full]
+        truth = _plate()["truth"]
+        big = [r for r in truth["reliefs"] if r["area"] >= doc["parameters"]["min_area"]]
+        self.assertEqual(len(bpy.context.scene.relief_snake_candidates), len(big))
+        self.assertTrue(any(t and "candidate" in t and "Esc cancels" in t for t in recorder.statuses),
+                        recorder.statuses)
+        self.assertIn(({'INFO'}, "%d candidates found" % len(big)), reports)
+
+    def test_detect_esc_leaves_everything_as_it_was(self):
+        items = bpy.context.scene.relief_snake_candidates
+        items.add().name = "An earlier candidate"
+        before = snapshot()
+        cls = addon().multi.MESH_OT_relief_snake_detect
+        op, reports, recorder, context = self.start(cls)
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})
+        for _ in range(3):
+            op.modal(context, _Event('TIMER'))
+            time.sleep(0.02)
+        self.assertFalse(op._job.done, "detect ended before Esc could be tested")
+        self.assertEqual(op.modal(context, _Event('ESC', 'PRESS')), {'CANCELLED'})
+        self.assertTrue(op._job.cancel_requested)
+        self.assertCleanedUp(op, recorder)
+        self.assertTrue(op._job.join(120))
+        self.assertTrue(op._job.cancelled)
+        self.assertIsNone(op._job.result)
+        self.assertEqual([i.name for i in items], ["An earlier candidate"])
+        self.assertNotIn(self.plate.name_full, addon().multi.DETECTIONS)
+        self.assertEqual(snapshot(), before)
+        self.assertIn(({'WARNING'}, "Relief Snake cancelled: nothing was changed"), reports)
+
+    def test_pick_groups_run_in_a_worker_and_write_the_reliefs(self):
+        self.pick_groups()
+        cls = addon().multi.MESH_OT_relief_snake_segment_groups
+        op, reports, recorder, context = self.start(cls, prefix="Picks")
+        ret = self.tick_until_done(op, context)
+        self.assertEqual(ret, {'FINISHED'}, reports)
+        self.assertCleanedUp(op, recorder)
+        self.assertIn(("progress_begin", 0, 2), recorder.calls)
+        self.assertIn(("progress_end",), recorder.calls)
+        self.assertTrue(any(t and "of 2 (Picks." in t for t in recorder.statuses), recorder.statuses)
+        truth = _plate()["truth"]
+        for name in ("Relief.A", "Relief.B"):
+            members = group_members(self.plate, name)
+            self.assertGreaterEqual(max(iou(members, r["vertices"]) for r in truth["reliefs"]), 0.9, name)
+            self.assertIsNotNone(bpy.data.objects.get("Plate_%sContour" % name))
+
+    def test_pick_groups_esc_changes_nothing(self):
+        self.pick_groups()
+        before = snapshot()
+        groups_before = [g.name for g in self.plate.vertex_groups]
+        cls = addon().multi.MESH_OT_relief_snake_segment_groups
+        op, reports, recorder, context = self.start(cls, prefix="Picks")
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})
+        op.modal(context, _Event('TIMER'))
+        self.assertEqual(op.modal(context, _Event('ESC', 'PRESS')), {'CANCELLED'})
+        self.assertCleanedUp(op, recorder)
+        self.assertTrue(op._job.join(120))
+        self.assertIsNone(op._job.result)
+        self.assertEqual([g.name for g in self.plate.vertex_groups], groups_before)
+        self.assertEqual(snapshot(), before)
+        self.assertIsNone(bpy.data.objects.get("Plate_Relief.AContour"))
+
+    def test_a_mesh_edited_during_the_run_gets_nothing(self):
+        self.pick_groups()
+        cls = addon().multi.MESH_OT_relief_snake_segment_groups
+        op, reports, recorder, context = self.start(cls, prefix="Picks")
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})
+        self.plate.data.vertices[0].co.z += 0.25  # the user edits while it runs (PASS_THROUGH)
+        ret = self.tick_until_done(op, context)
+        self.assertEqual(ret, {'CANCELLED'})
+        self.assertTrue(any("mesh changed" in text for _, text in reports), reports)
+        self.assertNotIn("Relief.A", [g.name for g in self.plate.vertex_groups])
+        self.assertCleanedUp(op, recorder)
+
+    def test_one_run_at_a_time(self):
+        multi = addon().multi
+        segment = addon().operators.MESH_OT_relief_snake_segment
+        first, _, recorder, context = self.start(multi.MESH_OT_relief_snake_detect)
+        for cls, attrs in ((multi.MESH_OT_relief_snake_detect, {}),
+                           (multi.MESH_OT_relief_snake_segment_groups, {"prefix": "Picks"})):
+            second, reports = self.make_operator(cls, **attrs)
+            self.assertEqual(second._invoke_modal(context), {'CANCELLED'})
+            self.assertIn(({'ERROR'}, "Relief Snake is already running: wait for it or press Esc"), reports)
+        # Segment refuses too while a several-reliefs run goes, and the other way round.
+        seg_op = type("Segment_stand_in", (), {"_invoke_modal": segment._invoke_modal,
+                                               "report": lambda self, kind, text: seg_reports.append(text)})()
+        seg_reports = []
+        self.assertEqual(seg_op._invoke_modal(context), {'CANCELLED'})
+        self.assertIn("already running", seg_reports[0])
+        self.assertEqual(first.modal(context, _Event('ESC', 'PRESS')), {'CANCELLED'})
+        self.assertIsNone(multi.busy())
+        segment._modal = "a Segment run"
+        second, reports = self.make_operator(multi.MESH_OT_relief_snake_detect)
+        self.assertEqual(second._invoke_modal(context), {'CANCELLED'})
+        segment._modal = None
+
+    def test_an_exception_in_a_modal_step_leaves_nothing_behind(self):
+        before = snapshot()
+        cls = addon().multi.MESH_OT_relief_snake_detect
+        op, reports, recorder, context = self.start(cls)
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})
+
+        def broken(self, context, event):
+            raise KeyError("a bug in a modal step")
+
+        type(op)._modal_step = broken
+        self.assertEqual(op.modal(context, _Event('TIMER')), {'CANCELLED'})
+        self.assertTrue(any("KeyError" in text for _, text in reports), reports)
+        self.assertCleanedUp(op, recorder)
+        self.assertTrue(op._job.cancel_requested)
+        op._job.join(120)
+        self.assertEqual(snapshot(), before)
+
+    def test_scripts_still_run_synchronously(self):
+        # EXEC_DEFAULT (and invoke in background mode) is execute(): done when the call returns.
+        self.assertEqual(bpy.ops.mesh.relief_snake_detect('EXEC_DEFAULT'), {'FINISHED'})
+        self.assertGreater(len(bpy.context.scene.relief_snake_candidates), 0)
+        self.assertEqual(bpy.ops.mesh.relief_snake_detect('INVOKE_DEFAULT'), {'FINISHED'})
+        self.assertIsNone(addon().multi.busy())

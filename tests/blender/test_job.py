@@ -158,5 +158,96 @@ class Worker(unittest.TestCase):
         self.assertTrue(all(j.cancelled for j in jobs))
 
 
+
+def _group_work(steps=20, step_seconds=0.01, groups=3, fail=None):
+    """A work(mesh, progress) for MeshJob: `groups` reliefs of `steps` progress calls each."""
+    def work(mesh, progress):
+        if fail:
+            raise fail
+        for g in range(groups):
+            for i in range(steps):
+                time.sleep(step_seconds)
+                if progress(g, "refine", i, 10 + i, [(g, 0, 0)] * 3) is False:
+                    raise StandInCore.Cancelled("cancelled")
+        return {"reliefs": list(range(groups)), "mesh": mesh}
+    return work
+
+
+class MeshJobWorker(unittest.TestCase):
+    """job.MeshJob: the worker of Detect and Segment Pick Groups (intake and the engine off the main thread)."""
+
+    def buffers(self, z=0.0):
+        r = request(z)
+        return r.vertices, r.triangles
+
+    def test_runs_the_work_with_the_relief_index_in_the_snapshots(self):
+        core = StandInCore()
+        j = job.MeshJob(core, *self.buffers(), _group_work(), key=None, cache=None).start()
+        self.assertIn(j, job.active_jobs())
+        seen = set()
+        while not j.done:
+            s = j.snapshot()
+            seen.add((s.stage, s.index))
+            time.sleep(0.005)
+        self.assertIsNone(j.error)
+        self.assertFalse(j.cancelled)
+        self.assertEqual(j.result["reliefs"], [0, 1, 2])
+        self.assertTrue({("refine", 0), ("refine", 1), ("refine", 2)} <= seen, seen)
+        self.assertEqual(core.meshes_built, 1)
+        self.assertNotIn(j, job.active_jobs())
+        self.assertEqual(j.digest, job.fingerprint(*self.buffers()))
+        self.assertEqual(j.num_vertices, 3)
+
+    def test_the_mesh_comes_from_the_cache_when_it_did_not_change(self):
+        core, cache = StandInCore(), job.MeshCache()
+        first = job.MeshJob(core, *self.buffers(), _group_work(steps=1), key="Plate", cache=cache).start()
+        first.join(5)
+        again = job.MeshJob(core, *self.buffers(), _group_work(steps=1), key="Plate", cache=cache).start()
+        again.join(5)
+        self.assertFalse(first.mesh_cached)
+        self.assertTrue(again.mesh_cached)
+        self.assertIs(first.result["mesh"], again.result["mesh"])
+        moved = job.MeshJob(core, *self.buffers(z=1.0), _group_work(steps=1), key="Plate", cache=cache).start()
+        moved.join(5)
+        self.assertFalse(moved.mesh_cached)
+        self.assertEqual(core.meshes_built, 2)
+
+    def test_cancel_returns_at_once_and_drops_the_result(self):
+        j = job.MeshJob(StandInCore(), *self.buffers(), _group_work(steps=1000), cache=None).start()
+        time.sleep(0.05)
+        t = time.perf_counter()
+        j.cancel()
+        self.assertLess(time.perf_counter() - t, 0.05)
+        self.assertTrue(j.join(2.0))
+        self.assertTrue(j.cancelled)
+        self.assertIsNone(j.result)
+        self.assertIsNone(j.error)
+
+    def test_cancel_during_intake_skips_the_work(self):
+        ran = []
+        core = StandInCore()
+        slow_mesh = core.Mesh
+
+        def slow(vertices, triangles):
+            time.sleep(0.2)
+            return slow_mesh(vertices, triangles)
+        core.Mesh = slow
+        j = job.MeshJob(core, *self.buffers(), lambda mesh, progress: ran.append(mesh), cache=None).start()
+        time.sleep(0.05)
+        self.assertEqual(j.snapshot().stage, "intake")
+        j.cancel()
+        self.assertTrue(j.join(2.0))
+        self.assertTrue(j.cancelled)
+        self.assertEqual(ran, [])
+
+    def test_engine_errors_end_the_job_with_their_message(self):
+        j = job.MeshJob(StandInCore(), *self.buffers(), _group_work(fail=StandInCore.Error("groups is empty")),
+                        cache=None).start()
+        self.assertTrue(j.join(2.0))
+        self.assertEqual(j.error, "groups is empty")
+        j = job.MeshJob(StandInCore(), *self.buffers(), _group_work(fail=KeyError("x")), cache=None).start()
+        self.assertTrue(j.join(2.0))
+        self.assertIn("KeyError", j.error)
+
 if __name__ == "__main__":
     unittest.main()

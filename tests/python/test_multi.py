@@ -280,3 +280,59 @@ def test_mesh_detect_arguments(disks):
         mesh.detect([0.5, 1.5])
     with pytest.raises(core.Cancelled):
         mesh.detect(progress=lambda *a: False)
+
+
+@pytest.mark.parametrize("method", ["segment_many", "detect"])
+def test_several_reliefs_release_the_gil_and_refuse_reentry(disks, method):
+    """The add-on's Detect and Segment Pick Groups run these in a worker thread while Blender's
+    main thread keeps drawing: the GIL must be released outside the progress callback, and a call
+    on the same Mesh from inside its own callback must fail at once instead of deadlocking."""
+    import threading
+    import time
+    vertices, triangles, groups, _ = disks
+    mesh = core.Mesh(vertices, triangles)
+
+    def call(progress=None):
+        if method == "segment_many":
+            return mesh.segment_many(groups, 1.0, progress=progress)
+        return mesh.detect(progress=progress)
+
+    stamps, stop, started = [], threading.Event(), threading.Event()
+
+    def spin():
+        started.set()
+        while not stop.is_set():
+            stamps.append(time.perf_counter())
+
+    t = threading.Thread(target=spin)
+    t.start()
+    started.wait()
+    try:
+        t0 = time.perf_counter()
+        call()  # no callback: the spinning thread runs only if the GIL is released
+        t1 = time.perf_counter()
+    finally:
+        stop.set()
+        t.join()
+    elapsed = t1 - t0
+    assert elapsed > 0.01, "%s too fast (%.4f s) to observe the GIL" % (method, elapsed)
+    middle = [s for s in stamps if t0 + 0.25 * elapsed < s < t0 + 0.75 * elapsed]
+    assert len(middle) > 100, (len(middle), elapsed)
+
+    inner = []
+
+    def reenter(*args):
+        if not inner:
+            for again in (lambda: mesh.detect(refine=False), lambda: mesh.segment_many(groups, 1.0),
+                          lambda: mesh.segment(groups[0], 1.0)):
+                try:
+                    again()
+                    inner.append("returned")
+                except RuntimeError as exc:
+                    inner.append(str(exc))
+        return False  # cancel the outer run
+
+    with pytest.raises(core.Cancelled):
+        call(reenter)
+    assert len(inner) == 3 and all("own progress callback" in text for text in inner), inner
+    assert call()["format"].startswith("relief-snake-")  # nothing left locked
