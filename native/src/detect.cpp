@@ -7,14 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <limits>
-#include <map>
-#include <queue>
 #include <sstream>
 
+#include "relief_snake/edge_distance.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/height_statistics.hpp"
+#include "relief_snake/region.hpp"
 
 namespace relief_snake {
 namespace {
@@ -106,57 +105,10 @@ std::vector<char> opening(const Mesh& mesh, const std::vector<int>& vertices, in
 /// nor leaving the seeds' mesh component.
 std::vector<char> grow(const Mesh& mesh, const std::vector<int>& seeds, double distance,
                        const std::function<bool(int)>& blocked) {
-  std::vector<double> dist(mesh.n_vertices(), std::numeric_limits<double>::infinity());
+  const std::vector<double> dist = edge_distances(mesh, seeds, distance, [&](int v) { return !blocked(v); });
   std::vector<char> out(mesh.n_vertices(), 0);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  for (const int s : seeds) dist[s] = 0, queue.push({0.0, s});
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > dist[v]) continue;
-    out[v] = 1;
-    for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w) {
-      if (blocked(*w)) continue;
-      const double nd = d + (mesh.position(*w) - mesh.position(v)).norm();
-      if (nd <= distance && nd < dist[*w]) dist[*w] = nd, queue.push({nd, *w});
-    }
-  }
+  for (int v = 0; v < mesh.n_vertices(); ++v) out[v] = dist[v] <= distance;
   return out;
-}
-
-/// The longest boundary loop (mesh vertices, in order with the set on the left) of the faces
-/// whose three corners are flagged.
-std::vector<int> outer_loop(const Mesh& mesh, const std::vector<char>& flag) {
-  auto inside = [&](int f) {
-    return f >= 0 && flag[mesh.face_vertex(f, 0)] && flag[mesh.face_vertex(f, 1)] && flag[mesh.face_vertex(f, 2)];
-  };
-  std::multimap<int, int> next;  // boundary edge a -> b, the set's face on its left
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    if (!inside(f)) continue;
-    for (int k = 0; k < 3; ++k)
-      if (!inside(mesh.face_neighbor(f, k))) next.emplace(mesh.face_vertex(f, (k + 1) % 3), mesh.face_vertex(f, (k + 2) % 3));
-  }
-  std::vector<int> best;
-  double best_length = 0;
-  while (!next.empty()) {
-    std::vector<int> loop;
-    auto it = next.begin();
-    const int start = it->first;
-    int at = start;
-    double length = 0;
-    while (it != next.end()) {
-      const int to = it->second;
-      next.erase(it);
-      loop.push_back(at);
-      length += (mesh.position(to) - mesh.position(at)).norm();
-      at = to;
-      if (at == start) break;
-      it = next.find(at);
-    }
-    if (at == start && length > best_length) best_length = length, best = std::move(loop);
-  }
-  return best;
 }
 
 /// Picks along a loop at about `spacing` apart (at least 6 when the loop allows).
@@ -340,7 +292,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
     const std::vector<char> grown =
         grow(mesh, raw[c].vertices, std::max(options.outline_offset * h, 3 * edge),
              [&](int w) { return label[w] >= 0 && label[w] != self; });
-    const std::vector<int> loop = outer_loop(mesh, grown);
+    const std::vector<int> loop = region_outer_loop(mesh, grown);
     for (const int v : loop) cand.outline.push_back(mesh.position(v));
     for (const int v : picks_along(mesh, loop, std::max(options.pick_spacing * h, 4 * edge)))
       cand.picks.push_back(static_cast<std::int64_t>(mesh.mesh_to_input(v)));

@@ -279,6 +279,15 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
                             " runs away from the step: the region takes in background there (a lobe out into "
                             "the background, or a bridge across a concavity)");
   }
+  const bool background_inside =
+      all.background_measured &&
+      all.background_depth > std::max(options.max_background_depth, all.background_depth_floor);
+  if (background_inside)
+    check.reasons.push_back("a piece of about " + number(all.background_area) + " h^2 inside the region around (" +
+                            number(all.background_where[0]) + ", " + number(all.background_where[1]) + ", " +
+                            number(all.background_where[2]) +
+                            ") lies at the background's height: the contour bridges a concavity there, or "
+                            "wraps a lobe of background");
   if (evidence.step_share >= options.min_step_share && evidence.foot_share < options.min_foot_share)
     check.reasons.push_back("only " + percent(evidence.foot_share) +
                             " of the contour sits at the foot of the step; the rest runs partway up it");
@@ -304,7 +313,7 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
   // Prefer evidence that holds; then more of the contour on a step, a region that agrees
   // with the coarse phase, and a step that agrees with h.
   const double ratio = evidence.step_height > 0 ? std::fabs(std::log(evidence.step_height / h)) : 2.0;
-  check.score = (check.holds ? 10.0 : 0.0) - 2.0 * evidence.far_share + 2.0 * evidence.step_share * std::min(1.0, measured / 0.6) +
+  check.score = (check.holds ? 10.0 : 0.0) - 2.0 * evidence.far_share - (background_inside ? 1.0 : 0.0) + 2.0 * evidence.step_share * std::min(1.0, measured / 0.6) +
                 std::min(coarse_iou, 0.8) - 0.5 * std::min(ratio, 2.0);
   return check;
 }

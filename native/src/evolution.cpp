@@ -206,6 +206,7 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
     changes += snake.remove_sharp_turns(phase.max_turn_degrees);
     changes += snake.resample(phase.l);
     if (phase.remove_loops) changes += snake.remove_loops();
+    changes += snake.trim_boundary_ends();
 
     if (snake.size() < phase.min_snaxels) {
       outcome.collapsed = true;

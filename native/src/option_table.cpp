@@ -168,6 +168,9 @@ const std::vector<Row>& rows() {
       boolean("foot_snap", &Options::foot_snap,
               "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
               "the background (not in the paper)"),
+      boolean("repair_background", &Options::repair_background,
+              "closed contours: cut out a piece of background the region took in (a bridged concavity, a lobe) "
+              "and refine again from the rest (not in the paper)"),
       integer("refine_levels", &Options::refine_levels, "a whole number from 0 to 16",
               [](long long n) { return n >= 0 && n <= 16; },
               "refinement spacings: 1 = the paper (straight to half an edge); 0 = coarse to fine from h/2 in "

@@ -2,6 +2,7 @@
 #include "relief_snake/region.hpp"
 
 #include <cstdint>
+#include <map>
 #include <unordered_set>
 
 #include "relief_snake/initial_contour.hpp"
@@ -207,6 +208,38 @@ bool contour_orientation_left(const Mesh& mesh, const std::vector<SurfacePoint>&
   }
   for (std::size_t i = 0; i < n; ++i) area += x[i].cross(x[(i + 1) % n]);
   return area.dot(normal_sum) > 0;
+}
+
+std::vector<int> region_outer_loop(const Mesh& mesh, const std::vector<char>& flag) {
+  auto inside = [&](int f) {
+    return f >= 0 && flag[mesh.face_vertex(f, 0)] && flag[mesh.face_vertex(f, 1)] && flag[mesh.face_vertex(f, 2)];
+  };
+  std::multimap<int, int> next;  // boundary edge a -> b, the set's face on its left
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    if (!inside(f)) continue;
+    for (int k = 0; k < 3; ++k)
+      if (!inside(mesh.face_neighbor(f, k))) next.emplace(mesh.face_vertex(f, (k + 1) % 3), mesh.face_vertex(f, (k + 2) % 3));
+  }
+  std::vector<int> best;
+  double best_length = 0;
+  while (!next.empty()) {
+    std::vector<int> loop;
+    auto it = next.begin();
+    const int start = it->first;
+    int at = start;
+    double length = 0;
+    while (it != next.end()) {
+      const int to = it->second;
+      next.erase(it);
+      loop.push_back(at);
+      length += (mesh.position(to) - mesh.position(at)).norm();
+      at = to;
+      if (at == start) break;
+      it = next.find(at);
+    }
+    if (at == start && length > best_length) best_length = length, best = std::move(loop);
+  }
+  return best;
 }
 
 }  // namespace relief_snake

@@ -109,8 +109,23 @@ const ScheduleRun& EvolutionSchedule::coarse(const ProgressCallback& progress) {
 }
 
 ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& progress) {
-  ScheduleRun run = coarse(progress);
-  if (run.cancelled || run.collapsed) return run;
+  const ScheduleRun& first = coarse(progress);
+  if (first.cancelled || first.collapsed) return first;
+  return refine_snake(*coarse_snake_, true, w_int, progress);  // each refinement starts from the coarse snake
+}
+
+ScheduleRun EvolutionSchedule::refine_from(const std::vector<SurfacePoint>& start, double w_int,
+                                           const ProgressCallback& progress) {
+  const ScheduleRun& first = coarse(progress);
+  if (first.cancelled || first.collapsed) return first;
+  Snake snake(mesh_, start, options_.closed, inside_left_);
+  snake.set_nearest_resampling(options_.nearest_resampling);
+  return refine_snake(snake, false, w_int, progress);
+}
+
+ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels, double w_int,
+                                            const ProgressCallback& progress) {
+  ScheduleRun run = coarse_run_;
   const DerivedParameters param = parameters(w_int);
 
   // A refinement setting at spacing l: alpha and beta normalised for l, gamma scaled with 1/l.
@@ -140,7 +155,7 @@ ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& prog
   // level run to convergence: the long moves into deep concavities happen at the
   // coarse levels, in few iterations of few snaxels.
   std::vector<double> refine_spacings = {refine.l};
-  if (options_.refine_levels != 1 && 0.5 * h_ > refine.l * 1.05) {
+  if (all_levels && options_.refine_levels != 1 && 0.5 * h_ > refine.l * 1.05) {
     const double span = 0.5 * h_ / refine.l;
     int levels = static_cast<int>(std::ceil(std::log2(span))) + 1;
     if (options_.refine_levels > 1) levels = std::min(levels, options_.refine_levels);
@@ -149,7 +164,7 @@ ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& prog
   }
   run.refine_levels = static_cast<int>(refine_spacings.size());
 
-  run.snake = std::make_shared<Snake>(*coarse_snake_);  // each refinement starts from the coarse snake
+  run.snake = std::make_shared<Snake>(start);
   Snake& snake = *run.snake;
   FeatureEnergy feature(planarity_, h_, options_.epsilon, options_.q_samples, options_.exact_q);
   feature.set_convex_barrier(options_.convex_barrier);

@@ -9,6 +9,7 @@
 
 #include "relief_snake/energy.hpp"
 #include "relief_snake/error.hpp"
+#include "relief_snake/background_inside.hpp"
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/evolution.hpp"
 #include "relief_snake/foot.hpp"
@@ -116,6 +117,9 @@ struct Segmenter::Cache {
   std::unique_ptr<PlanarityField> planarity;
   PlanarityOptions options;  // what it was computed with
   std::shared_ptr<const MomentTree> tree;  // does not depend on h: kept across planarity fields
+  // The thin-plate fill's Laplacian (background_inside.hpp): cotangent weights, and uniform ones
+  // where those are singular.
+  std::unique_ptr<BackgroundSolver> background, background_uniform;
 };
 
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
@@ -261,7 +265,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   // --- attempts: schedule -> foot -> region -> self-check, for each h and W_int tried
   const std::vector<double> w_steps =
       options.w_int > 0 ? std::vector<double>{options.w_int} : std::vector<double>{0.25, 0.5, 1.0};
-  double preprocess_seconds = 0;
+  double preprocess_seconds = 0, background_seconds = 0;
   bool cancelled = false;
   std::string collapse_phase;
   auto attempt_at = [&](double h_try) {
@@ -294,23 +298,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     }
     const std::vector<char> coarse_region = relief_region(mesh, coarse.contour, options.closed, inside_left);
     const double coarse_step_share = measure_step(mesh, coarse.contour, coarse_region, h_try, evidence_options).step_share;
-    bool first = true;
-    for (const double w : w_steps) {
-      Attempt a;
-      a.h = h_try;
-      a.w_int = w;
-      a.run = schedule.refine(w, progress);
-      a.parameters = schedule.parameters(w);
-      ++result.attempts;
-      if (a.run.cancelled) {
-        cancelled = true;
-        return best;
-      }
-      if (a.run.collapsed) {
-        collapse_phase = a.run.collapsed_phase;
-        if (first) best = a, first = false;
-        continue;
-      }
+    // The foot stage and the self-check of one refined run (a.run).
+    auto settle_and_judge = [&](Attempt& a, BackgroundInside* inside_out) {
       if (options.foot_snap) {
         Snake& snake = *a.run.snake;
         FootOptions fo;
@@ -321,6 +310,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         for (int guard = 0; guard < 100 && snake.remove_loops() > 0; ++guard) {
         }
         snake.remove_sharp_turns(options.max_turn_degrees);
+        snake.trim_boundary_ends();
         if (foot.noisy)
           a.notes.push_back("not settled at the foot: the background is too noisy (residual " +
                             fmt(foot.background_residual / h_try) + " h)");
@@ -355,6 +345,85 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       const int far_index = a.evidence.step.far_point;
       const Vec3 far_position = far_index >= 0 ? position(mesh, a.run.contour[far_index]) : Vec3::Zero();
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
+      // The region-wide check only where the contour-wise one holds (a fill per attempt costs about
+      // as much as a refinement on large regions), and for the repair of a region that took in
+      // background; a failing attempt is doubtful already.
+      if (a.check.holds) {
+        if (!cache_->background) cache_->background = std::make_unique<BackgroundSolver>(mesh);
+        BackgroundInside inside =
+            measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height, cache_->background.get());
+        background_seconds += inside.seconds;
+        if (!inside.measured) {  // cotangent weights of a sharp wall's projection can be singular
+          if (!cache_->background_uniform) {
+            BackgroundOptions uniform;
+            uniform.laplacian = BackgroundLaplacian::Uniform;
+            cache_->background_uniform = std::make_unique<BackgroundSolver>(mesh, uniform);
+          }
+          inside = measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height,
+                                             cache_->background_uniform.get());
+          background_seconds += inside.seconds;
+        }
+        a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;
+        a.evidence.background_depth = inside.depth / h_try;
+        a.evidence.background_area = inside.area / (h_try * h_try);
+        a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
+        if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.position(inside.deepest_vertex);
+        if (inside_out) *inside_out = std::move(inside);
+        a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
+      }
+    };
+    // Repair (closed contours; not in the paper): a region that took in a piece of background
+    // (a bridged concavity, a lobe round a texture dot) loses it, and the snake is refined again
+    // from the rest's outline at the finest spacing, where narrow concavities hold it.
+    auto repaired = [&](const Attempt& a, const BackgroundInside& inside, double w) {
+      Attempt r;
+      const double limit = std::max(self_check.max_background_depth, a.evidence.background_depth_floor) * h_try;
+      std::vector<int> loop = region_outer_loop(mesh, inside.region_without(a.region, limit));
+      if (loop.size() < 8) return r;
+      if (!inside_left) std::reverse(loop.begin(), loop.end());
+      std::vector<SurfacePoint> outline;
+      outline.reserve(loop.size());
+      for (const int v : loop) outline.push_back(vertex_point(mesh, v));
+      r.h = h_try;
+      r.w_int = w;
+      r.run = schedule.refine_from(outline, w, progress);
+      r.parameters = a.parameters;
+      ++result.attempts;
+      if (r.run.cancelled || r.run.collapsed) return r;
+      settle_and_judge(r, nullptr);
+      r.notes.insert(r.notes.begin(), "repaired: a piece of background of about " + fmt(a.evidence.background_area) +
+                                          " h^2 that the contour took in was cut out, and the snake refined again "
+                                          "from the rest");
+      return r;
+    };
+    bool first = true;
+    for (const double w : w_steps) {
+      Attempt a;
+      a.h = h_try;
+      a.w_int = w;
+      a.run = schedule.refine(w, progress);
+      a.parameters = schedule.parameters(w);
+      ++result.attempts;
+      if (a.run.cancelled) {
+        cancelled = true;
+        return best;
+      }
+      if (a.run.collapsed) {
+        collapse_phase = a.run.collapsed_phase;
+        if (first) best = a, first = false;
+        continue;
+      }
+      BackgroundInside inside;
+      settle_and_judge(a, &inside);
+      if (options.repair_background && options.closed && !a.check.holds && a.evidence.background_measured &&
+          a.evidence.background_depth > std::max(self_check.max_background_depth, a.evidence.background_depth_floor)) {
+        Attempt r = repaired(a, inside, w);
+        if (r.run.cancelled) {
+          cancelled = true;
+          return best;
+        }
+        if (r.usable() && better(r, a)) a = std::move(r);
+      }
       const bool holds = a.check.holds;
       if (first || better(a, best)) best = std::move(a);
       first = false;
@@ -456,7 +525,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"offset_q90", step.offset_q90 / best.h},
                    {"offset_q95", step.offset_q95 / best.h},
                    {"far_share", step.far_share},
-                   {"far_run", step.longest_far / best.h}});
+                   {"far_run", step.longest_far / best.h},
+                   {"background_depth", best.evidence.background_depth},
+                   {"background_area", best.evidence.background_area}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (best.run.hit_cap) {
@@ -475,6 +546,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     message += ".";
     result.message = message;
   }
+  result.checks.push_back({"background_seconds", background_seconds});
   result.checks.push_back({"seconds", seconds_since(t_start)});
   return result;
 }

@@ -352,6 +352,28 @@ bool segments_cross(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
 
 }  // namespace
 
+int Snake::trim_boundary_ends() {
+  if (closed_) return 0;
+  auto on_boundary = [&](int i) {
+    int f, k;
+    return boundary_edge_of(mesh_, snaxels_[i].point, &f, &k);
+  };
+  int front = 0;
+  while (size() - front > 3 && on_boundary(front) && on_boundary(front + 1)) ++front;
+  int back = size();
+  while (back - front > 3 && on_boundary(back - 1) && on_boundary(back - 2)) --back;
+  const int removed = front + (size() - back);
+  if (removed == 0) return 0;
+  snaxels_.erase(snaxels_.begin() + back, snaxels_.end());
+  snaxels_.erase(snaxels_.begin(), snaxels_.begin() + front);
+  // The new ends may slide again.
+  for (const int i : {0, size() - 1}) {
+    snaxels_[i].locked = false;
+    touch(i);
+  }
+  return removed;
+}
+
 int Snake::remove_loops() {
   // Untouched segments did not cross at the last call and have not moved since: only
   // pairs with a changed segment can cross now.

@@ -155,6 +155,22 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   c = judge(e, 1.0, {}, &where);
   ASSERT_EQ(c.reasons.size(), 1u);
   EXPECT_NE(c.reasons.front().find("(1, 2, 3)"), std::string::npos);
+  e.step.longest_far = 0;
+  // Background inside the region: judged only when measured, above the depth and the edge floor.
+  e.background_depth = 2.0;
+  e.background_area = 7.5;
+  e.background_where = Vec3(4, 5, 6);
+  EXPECT_TRUE(judge(e, 1.0).holds);  // not measured
+  e.background_measured = true;
+  c = judge(e, 1.0);
+  ASSERT_EQ(c.reasons.size(), 1u);
+  EXPECT_NE(c.reasons.front().find("7.5 h^2"), std::string::npos);
+  EXPECT_NE(c.reasons.front().find("(4, 5, 6)"), std::string::npos);
+  e.background_depth_floor = 2.5;  // on a coarse mesh a 2 h strip is one edge or two
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.background_depth_floor = 0;
+  e.background_depth = 0.5;
+  EXPECT_TRUE(judge(e, 1.0).holds);
 }
 
 TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {

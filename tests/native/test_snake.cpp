@@ -93,6 +93,34 @@ TEST(Snake, OpenEndsSlideAlongTheBoundary) {
   EXPECT_NEAR(c.x(), 2, 1e-9);
 }
 
+TEST(Snake, AnOpenSnakeDropsTheSnaxelsHeldAlongTheBoundary) {
+  // A plane 10 x 10: the snake runs along the bottom border from x = 1 to x = 4, turns up into the
+  // mesh, across, and back down to the border at x = 8, then along it to x = 9.
+  const Mesh mesh = test::plane_mesh(21, 10);
+  std::vector<SurfacePoint> pts;
+  for (double x = 1; x <= 4.01; x += 0.5) pts.push_back(point_at(mesh, Vec3(x, 0, 0)));
+  for (double y = 1; y <= 5.01; y += 1) pts.push_back(point_at(mesh, Vec3(4, y, 0)));
+  for (double x = 5; x <= 7.01; x += 1) pts.push_back(point_at(mesh, Vec3(x, 5, 0)));
+  for (double y = 4; y >= 0.99; y -= 1) pts.push_back(point_at(mesh, Vec3(8, y, 0)));
+  for (double x = 8; x <= 9.01; x += 0.5) pts.push_back(point_at(mesh, Vec3(x, 0, 0)));
+  Snake snake(mesh, pts, false, true);
+  const int before = snake.size();
+  EXPECT_EQ(snake.trim_boundary_ends(), 6 + 2);  // x = 1 .. 3.5 at the start, x = 8.5, 9 at the end
+  EXPECT_EQ(snake.size(), before - 8);
+  // Each end is now the last boundary point before the snake leaves the boundary.
+  EXPECT_NEAR((snake[0].position - Vec3(4, 0, 0)).norm(), 0, 1e-9);
+  EXPECT_NEAR((snake[snake.size() - 1].position - Vec3(8, 0, 0)).norm(), 0, 1e-9);
+  EXPECT_EQ(snake.trim_boundary_ends(), 0);  // nothing left to trim
+  // A snake lying wholly along the boundary keeps three snaxels; a closed one is never trimmed.
+  std::vector<SurfacePoint> border;
+  for (double x = 1; x <= 9.01; x += 1) border.push_back(point_at(mesh, Vec3(x, 0, 0)));
+  Snake flat(mesh, border, false, true);
+  flat.trim_boundary_ends();
+  EXPECT_EQ(flat.size(), 3);
+  Snake loop(mesh, circle(mesh, Vec3(5, 5, 0), 3, 24), true, true);
+  EXPECT_EQ(loop.trim_boundary_ends(), 0);
+}
+
 TEST(Snake, SubdivideReachesTheRequestedSpacing) {
   const Mesh mesh = test::plane_mesh(41, 20);
   Snake snake(mesh, circle(mesh, Vec3(10, 10, 0), 5, 10), true, true);

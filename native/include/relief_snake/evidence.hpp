@@ -96,6 +96,10 @@ struct SelfCheckOptions {
   /// Longest stretch of contour (in h) allowed to run away from the step (StepEvidence::longest_far):
   /// a lobe out into the background, or a bridge across a concavity.
   double max_far_run = 1.5;
+  /// Deepest piece of background allowed inside the region (BackgroundInside::depth, in h; and
+  /// at least ContourEvidence::background_depth_floor): a bridged concavity or a lobe holds a
+  /// disk of background, a step's foot or a groove only a strip.
+  double max_background_depth = 0.75;
 };
 
 /// Everything the self-check looks at for one contour.
@@ -105,6 +109,11 @@ struct ContourEvidence {
   double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
   double area_ratio = 1;        ///< closed contours: the region's vector area against the contour's (1: they agree)
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
+  /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
+  /// depth and area, and the floor under the depth threshold (two average edges, in h).
+  bool background_measured = false;
+  double background_depth = 0, background_area = 0, background_depth_floor = 0;
+  Vec3 background_where = Vec3::Zero();  ///< the deepest point of that piece
 };
 
 /// The verdict on one contour.

@@ -27,4 +27,8 @@ std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint
 /// normal along it is positive. Then the inside is to the left (inside_left = true).
 bool contour_orientation_left(const Mesh& mesh, const std::vector<SurfacePoint>& closed_contour);
 
+/// The longest closed boundary loop of the faces whose three corners are flagged (#V flags):
+/// mesh vertices in order, with those faces on the left seen from outside. Empty if none.
+std::vector<int> region_outer_loop(const Mesh& mesh, const std::vector<char>& flag);
+
 }  // namespace relief_snake

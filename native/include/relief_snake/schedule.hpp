@@ -43,6 +43,10 @@ class EvolutionSchedule {
   /// Refinement and stabilisation with this W_int, from the coarse snake. Runs the
   /// coarse phase first if needed. The returned phases include the coarse one.
   ScheduleRun refine(double w_int, const ProgressCallback& progress);
+  /// Refinement and stabilisation with this W_int from another start (a repaired contour, already
+  /// near the step: only the finest spacing runs). Runs the coarse phase first if needed (its
+  /// phase is reported like refine()'s).
+  ScheduleRun refine_from(const std::vector<SurfacePoint>& start, double w_int, const ProgressCallback& progress);
 
  private:
   const Mesh& mesh_;
@@ -55,6 +59,7 @@ class EvolutionSchedule {
   bool coarse_done_ = false;
   ScheduleRun coarse_run_;
   std::unique_ptr<Snake> coarse_snake_;  // as the coarse phase left it
+  ScheduleRun refine_snake(const Snake& start, bool all_levels, double w_int, const ProgressCallback& progress);
 };
 
 }  // namespace relief_snake

@@ -65,6 +65,10 @@ struct Options {
   /// After stabilisation, move each snaxel out to the foot of the step, where the surface
   /// leaves the background continued from outside (foot.hpp; not in the paper).
   bool foot_snap = false;
+  /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
+  /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
+  /// better evidence (not in the paper).
+  bool repair_background = true;
   /// New snaxels (splits, merges, the refinement's subdivision) at the surface point nearest the
   /// chord between their neighbours, instead of the end of a straight surface walk along it.
   bool nearest_resampling = true;

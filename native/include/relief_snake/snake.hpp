@@ -72,6 +72,12 @@ class Snake {
   /// that changed since the last call are checked against the others, so the
   /// snake must have had no crossing then. Not in the paper: see Options::remove_loops.
   int remove_loops();
+  /// Open snakes: drops the snaxels at either end that lie on the mesh boundary behind the
+  /// next one, so each end is the last boundary point before the snake leaves the boundary;
+  /// returns how many went. Interior snaxels stuck along the boundary hold an end back (their
+  /// inward moves leave the mesh) and add nothing to the region, which closes along the
+  /// boundary anyway. At least three snaxels stay.
+  int trim_boundary_ends();
   /// Resamples every segment to spacing ~l by walking between consecutive snaxels
   /// (used when the refinement phase starts with a shorter l).
   void subdivide(double l);

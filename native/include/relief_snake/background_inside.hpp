@@ -1,0 +1,58 @@
+#pragma once
+// Background inside a region: does a segmentation's region take in a piece of background? (Not
+// in the paper.) A snake that bridges a concavity's mouth, or wraps a lobe around a texture dot,
+// can sit on a step almost everywhere along its contour: the contour-wise step evidence
+// (evidence.hpp) sees walls on both sides of the bridge and calls it a step. The heights tell: the
+// piece behind the bridge lies at the background's height, as the ring outside the contour does.
+//
+// 1-2. The background: the thin-plate fill of background.hpp (a ring of background around the
+//    region, continued smoothly under it), or a robust quadric over that ring (Tukey's biweight,
+//    height_statistics.hpp: cheaper, but a wavy or vase-like background is not a quadric); each
+//    region vertex's height above it.
+// 3. Low pieces: connected sets of region vertices lower than low_share of the step found, that
+//    touch the outside (the contour). Each piece's depth is its inradius: the largest distance
+//    from one of its vertices to the nearest vertex that is not in it (relief, or outside).
+//    A blended step's foot, a groove or the gap between the contour and the foot is a thin strip;
+//    a bridged concavity or a lobe holds a disk of background.
+#include <vector>
+
+#include "relief_snake/background.hpp"
+#include "relief_snake/mesh.hpp"
+
+namespace relief_snake {
+
+enum class BackgroundInsideModel { ThinPlate, RingQuadric };
+
+struct BackgroundInsideOptions {
+  BackgroundInsideModel model = BackgroundInsideModel::ThinPlate;
+  double ring_width = 2.5;     ///< RingQuadric: the ring, in h (and at least ring_width_edges average edges)
+  double ring_width_edges = 6;
+  double low_share = 0.5;      ///< a region vertex lower than this share of the step is background-like
+};
+
+struct BackgroundInside {
+  bool measured = false;       ///< false: no ring (the region covers its component) or too few vertices
+  double ring_sigma = 0;       ///< the ring's heights above the fit: robust noise (quadric), RMS residual (thin plate)
+  double seconds = 0;          ///< time taken
+  double step = 0;             ///< the step the low share was taken of
+  /// The largest low piece touching the outside, by depth: its depth (inradius) and area, and a
+  /// vertex at its deepest point (-1: none).
+  double depth = 0, area = 0;
+  int deepest_vertex = -1;
+  double low_area = 0;         ///< total area of all low pieces touching the outside
+  /// #V: the low piece each region vertex belongs to (-1: none), and per piece its depth, or -1
+  /// for a piece that does not touch the outside (a hollow inside the relief).
+  std::vector<int> piece;
+  std::vector<double> piece_depth;
+  /// The region without the low pieces touching the outside deeper than `depth` (mesh units).
+  std::vector<char> region_without(const std::vector<char>& region, double depth) const;
+};
+
+/// region: #V flags (1 = relief side). h: the segmentation's step height; step: the step found along
+/// the contour (the low threshold is low_share x step). solver: the thin-plate fill for this mesh
+/// (reused across calls; required for the ThinPlate model, else unused).
+BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<char>& region, double h, double step,
+                                           const BackgroundSolver* solver,
+                                           const BackgroundInsideOptions& options = {});
+
+}  // namespace relief_snake
