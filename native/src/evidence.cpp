@@ -259,6 +259,11 @@ Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region) {
   return area;
 }
 
+bool background_taken_in(const ContourEvidence& e, const SelfCheckOptions& options) {
+  const double limit = std::max(options.max_background_depth, e.background_depth_floor);
+  return e.background_measured && e.background_depth > limit && e.background_area >= 0.5 * M_PI * limit * limit;
+}
+
 SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options, const Vec3* far_position) {
   SelfCheck check;
   const StepEvidence& evidence = all.step;
@@ -279,9 +284,7 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
                             " runs away from the step: the region takes in background there (a lobe out into "
                             "the background, or a bridge across a concavity)");
   }
-  const bool background_inside =
-      all.background_measured &&
-      all.background_depth > std::max(options.max_background_depth, all.background_depth_floor);
+  const bool background_inside = background_taken_in(all, options);
   if (background_inside)
     check.reasons.push_back("a piece of about " + number(all.background_area) + " h^2 inside the region around (" +
                             number(all.background_where[0]) + ", " + number(all.background_where[1]) + ", " +

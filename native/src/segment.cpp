@@ -120,6 +120,7 @@ struct Segmenter::Cache {
   // The thin-plate fill's Laplacian (background_inside.hpp): cotangent weights, and uniform ones
   // where those are singular.
   std::unique_ptr<BackgroundSolver> background, background_uniform;
+  std::unique_ptr<BackgroundSolver> background_surface;  // the second opinion: a fill of the positions
 };
 
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
@@ -367,6 +368,22 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.evidence.background_depth = inside.depth / h_try;
         a.evidence.background_area = inside.area / (h_try * h_try);
         a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
+        // A piece must also show under the fill of the positions themselves: the height field misses
+        // the shape of a large relief's background on a vase, where the relief then seems to sag.
+        if (background_taken_in(a.evidence, self_check)) {
+          if (!cache_->background_surface) {
+            BackgroundOptions surface;
+            surface.model = BackgroundModel::Surface;
+            cache_->background_surface = std::make_unique<BackgroundSolver>(mesh, surface);
+          }
+          const BackgroundInside second = measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height,
+                                                                    cache_->background_surface.get());
+          background_seconds += second.seconds;
+          if (second.measured && second.depth < inside.depth) {
+            a.evidence.background_depth = second.depth / h_try;
+            a.evidence.background_area = second.area / (h_try * h_try);
+          }
+        }
         if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.position(inside.deepest_vertex);
         if (inside_out) *inside_out = std::move(inside);
         a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
@@ -415,8 +432,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       }
       BackgroundInside inside;
       settle_and_judge(a, &inside);
-      if (options.repair_background && options.closed && !a.check.holds && a.evidence.background_measured &&
-          a.evidence.background_depth > std::max(self_check.max_background_depth, a.evidence.background_depth_floor)) {
+      if (options.repair_background && options.closed && !a.check.holds && background_taken_in(a.evidence, self_check)) {
         Attempt r = repaired(a, inside, w);
         if (r.run.cancelled) {
           cancelled = true;
