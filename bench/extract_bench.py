@@ -7,8 +7,10 @@ For each background (plane, cylinder, sphere, saddle) and size, make-scan writes
 its true relief vertices stand in for the segmentation, `relief-snake extract` runs on them, and
 the outputs are scored: base error (distance of the moved vertices from the true background) and
 height error (|height - h| on relief.ply), both over relief vertices more than `--margin` h inside
-the true boundary, in units of h; plus the engine's own times (background fill, height map).
-Prints one line per case; the target is under 0.5 s for a 290k-triangle scan's relief (judged on
+the true boundary, in units of h; plus the engine's own times (background fill, height map) and,
+on a second line, each stage's wall time (`extract --timings`: reading the result, loading the
+mesh, Laplacian weights, ring, assembly, ordering, factorisation, solve, height, relief patch,
+plane, the conformal map's stages, rasterising, writing the five files). Prints one line per case; the target is under 0.5 s for a 290k-triangle scan's relief (judged on
 CPU time, which includes writing the five files; wall times on a loaded machine are printed too).
 """
 
@@ -106,11 +108,14 @@ def run_case(build, background, triangles, margin, work):
 
     _, load_cpu, _ = cpu_of([str(build / "relief-snake"), "info", str(prefix) + ".ply"])
     r, extract_cpu, wall = cpu_of([str(build / "relief-snake"), "extract", str(prefix) + ".ply", str(result_path),
-                                   "--out", str(out), "--quiet"])
+                                   "--out", str(out), "--quiet", "--timings"])
     if r.returncode != 0:
         return {"case": prefix.name, "error": r.stderr.strip()}
     m = re.search(r"background ([0-9.]+) s, height map ([0-9.]+) s", r.stdout)
     fill_s, map_s = float(m.group(1)), float(m.group(2))
+    # Each stage's wall time: "relief-snake: timings: read result 0.012 s, load mesh 0.2 s, ..."
+    t = re.search(r"timings: (.*)$", r.stdout, re.M)
+    stages = {name: float(sec) for name, sec in re.findall(r"([a-z][a-z ]*?) ([0-9.]+) s", t.group(1))} if t else {}
     sidecar = json.loads((out / "height.json").read_text())
 
     base, _ = read_ply(out / "background.ply")
@@ -133,7 +138,7 @@ def run_case(build, background, triangles, margin, work):
             "flattening": sidecar["frame"]["flattening"],
             "angle_distortion": sidecar["frame"]["distortion"]["angle_mean"],
             "fill_seconds": fill_s, "map_seconds": map_s, "wall_seconds": wall,
-            "extract_cpu_seconds": max(0.0, extract_cpu - load_cpu)}
+            "extract_cpu_seconds": max(0.0, extract_cpu - load_cpu), "stages": stages}
 
 
 def main():
@@ -164,6 +169,9 @@ def main():
                          row["height_mean"], row["height_max"], row["ring_rms"], row["flattening"],
                          row["angle_distortion"], row["fill_seconds"], row["map_seconds"],
                          row["extract_cpu_seconds"], "under" if row["extract_cpu_seconds"] < 0.5 else "OVER"))
+                if row["stages"]:
+                    shown = ", ".join("%s %.3f" % (k, v) for k, v in row["stages"].items() if v >= 0.0005)
+                    print("%-16s   stages (s, wall): %s" % ("", shown))
     if args.json:
         Path(args.json).write_text(json.dumps(rows, indent=2))
     return 0 if all("error" not in r for r in rows) else 1

@@ -29,6 +29,7 @@ const char* kExtractUsage =
     "  --pixel-size S         height-map pixel size in mesh units (default half the average edge)\n"
     "  --flatten M            auto (default): plane for gentle backgrounds, else conformal\n"
     "  --step-height H        h, if RESULT.json does not record it (it sets the background ring's width)\n"
+    "  --timings              also print each stage's time (reading, loading, solving, flattening, writing)\n"
     "  segment ... --extract DIR [--pixel-size S] [--flatten M] segments, then extracts into DIR\n"
     "  (the result goes to DIR/result.json unless --out is given).\n";
 
@@ -49,9 +50,10 @@ struct ExtractArgs {
   double pixel_size = 0, step_height = 0;
   Flattening flattening = Flattening::Auto;
   bool quiet = false;
+  bool timings = false;
 };
 
-/// Reads --pixel-size, --flatten, --step-height, --out, --quiet; the rest are positional.
+/// Reads --pixel-size, --flatten, --step-height, --out, --quiet, --timings; the rest are positional.
 ExtractArgs parse(const std::vector<std::string>& args, std::vector<std::string>* positional) {
   ExtractArgs a;
   for (std::size_t k = 0; k < args.size(); ++k) {
@@ -83,6 +85,8 @@ ExtractArgs parse(const std::vector<std::string>& args, std::vector<std::string>
       }
     } else if (name == "--quiet" || name == "-q") {
       a.quiet = true;
+    } else if (name == "--timings" && !inline_value) {
+      a.timings = true;
     } else if (name.size() > 1 && name[0] == '-') {
       throw ExtractUsage("unknown option '" + name + "' for extract (see relief-snake --help)");
     } else {
@@ -95,6 +99,10 @@ ExtractArgs parse(const std::vector<std::string>& args, std::vector<std::string>
 int usage_failure(const std::string& message) {
   std::cerr << "relief-snake: " << message << std::endl;
   return 2;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 int extract_files(const ExtractArgs& a) {
@@ -129,7 +137,10 @@ int extract_files(const ExtractArgs& a) {
   if (!(h > 0))
     throw Error("'" + a.result_path + "' does not record the step height; give it with --step-height H");
 
+  const double read_seconds = seconds_since(start);
+  const auto load_start = std::chrono::steady_clock::now();
   const Mesh mesh = Mesh::load(a.mesh_path);
+  const double load_seconds = seconds_since(load_start);
   std::vector<std::string> notes;
   if (expected < 0)
     notes.push_back("the result does not record its mesh's vertex count; its indices were checked against the mesh only");
@@ -143,11 +154,16 @@ int extract_files(const ExtractArgs& a) {
     x.notes.push_back("intake merged or dropped vertices: background.ply holds the mesh's " +
                       std::to_string(mesh.n_vertices()) + " vertices, not the file's " +
                       std::to_string(mesh.input_vertex_count()));
+  const auto write_start = std::chrono::steady_clock::now();
   write_extraction(mesh, x, a.out_dir);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double write_seconds = seconds_since(write_start);
+  const double seconds = seconds_since(start);
   if (!a.quiet)
     for (const std::string& note : x.notes) std::fprintf(stderr, "relief-snake: note: %s\n", note.c_str());
   std::printf("relief-snake: %s; wrote %s in %.2f s total\n", x.summary().c_str(), a.out_dir.c_str(), seconds);
+  if (a.timings)
+    std::printf("relief-snake: timings: read result %.3f s, load mesh %.3f s, %s, write %.3f s\n", read_seconds,
+                load_seconds, x.timings_text().c_str(), write_seconds);
   std::fflush(stdout);
   return 0;
 }

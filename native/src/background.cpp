@@ -142,26 +142,12 @@ bool make_height_field(const Mesh& mesh, const std::vector<char>& region, const 
 
 BackgroundSolver::BackgroundSolver(const Mesh& mesh, const BackgroundOptions& options)
     : mesh_(mesh), options_(options) {
+  // Only the one-ring offsets: each solve() computes the Laplacian weights of the faces its rows
+  // touch (a relief's few percent of the mesh), not the whole mesh's up front.
   const int nv = mesh.n_vertices();
   ring_offset_.resize(static_cast<std::size_t>(nv) + 1, 0);
   for (int v = 0; v < nv; ++v)
     ring_offset_[v + 1] = ring_offset_[v] + static_cast<std::size_t>(mesh.neighbors_end(v) - mesh.neighbors_begin(v));
-  edge_weight_.assign(ring_offset_[nv], options.laplacian == BackgroundLaplacian::Uniform ? 1.0 : 0.0);
-  if (options.laplacian == BackgroundLaplacian::Uniform) return;
-  // Entry of b in a's one-ring (degrees are small: a linear search).
-  auto slot = [&](int a, int b) -> double& {
-    const int* begin = mesh.neighbors_begin(a);
-    const int* it = std::find(begin, mesh.neighbors_end(a), b);
-    return edge_weight_[ring_offset_[a] + static_cast<std::size_t>(it - begin)];
-  };
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int c = mesh.face_vertex(f, k), a = mesh.face_vertex(f, (k + 1) % 3), b = mesh.face_vertex(f, (k + 2) % 3);
-      const double half_cot = 0.5 * cotangent(mesh.position(a), mesh.position(b), mesh.position(c));
-      slot(a, b) += half_cot;
-      slot(b, a) += half_cot;
-    }
-  }
 }
 
 BackgroundResult BackgroundSolver::solve_vertices(const std::vector<int>& region_vertices, double h) const {
@@ -256,6 +242,9 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   if (r.ring_vertices.empty())
     return failure(BackgroundStatus::NoRing, "no background around the relief region; segment a smaller region");
 
+  r.timings.ring = seconds_since(start);
+  const auto assembly_start = std::chrono::steady_clock::now();
+
   // --- unknowns, rows (vertices whose Laplacian involves an unknown), fixed columns.
   const bool soft = options_.smoothing > 0;
   std::vector<int> unknown_id(static_cast<std::size_t>(nv), -1), fixed_id(static_cast<std::size_t>(nv), -1);
@@ -318,18 +307,19 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     for (const int v : fixed) set_footprint(v);
   }
 
-  // Laplacian weights per one-ring entry and areas: the scan's (Surface) or those of the plane
-  // projection (HeightField: a planar parameterisation, so linear offsets fill exactly).
-  const std::vector<double>* weights = &edge_weight_;
-  std::vector<double> projected_weight;
+  // Laplacian weights per one-ring entry (aligned with Mesh::neighbors_begin(v)) and areas, from
+  // the faces around the rows: the scan's own triangles (Surface) or their plane projection
+  // (HeightField: a planar parameterisation, so linear offsets fill exactly).
+  const bool uniform = options_.laplacian == BackgroundLaplacian::Uniform;
+  std::vector<double> weights(ring_offset_[nv], uniform ? 1.0 : 0.0);
   std::vector<double> area(static_cast<std::size_t>(nv), 0.0);
-  if (height_field) {
-    projected_weight.assign(edge_weight_.size(), options_.laplacian == BackgroundLaplacian::Uniform ? 1.0 : 0.0);
+  {
     std::vector<char> face_done(static_cast<std::size_t>(mesh.n_faces()), 0);
+    // Entry of b in a's one-ring (degrees are small: a linear search).
     auto slot = [&](int a, int b) -> double& {
       const int* begin = mesh.neighbors_begin(a);
       const int* it = std::find(begin, mesh.neighbors_end(a), b);
-      return projected_weight[ring_offset_[a] + static_cast<std::size_t>(it - begin)];
+      return weights[ring_offset_[a] + static_cast<std::size_t>(it - begin)];
     };
     for (const int v : rows)
       for (const int* f = mesh.faces_begin(v); f != mesh.faces_end(v); ++f) {
@@ -337,11 +327,16 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
         face_done[*f] = 1;
         const int c[3] = {mesh.face_vertex(*f, 0), mesh.face_vertex(*f, 1), mesh.face_vertex(*f, 2)};
         Vec3 q[3];
-        for (int k = 0; k < 3; ++k) q[k] = Vec3(footprint[c[k]].x(), footprint[c[k]].y(), 0);
-        const double signed_third = (q[1] - q[0]).cross(q[2] - q[0]).z() / 6.0;
-        for (int k = 0; k < 3; ++k) area[c[k]] += std::abs(signed_third);
-        // Folded faces (steep relief walls) get no cotangent weight: they are not part of the base.
-        if (options_.laplacian == BackgroundLaplacian::Uniform || signed_third <= 0) continue;
+        if (height_field) {
+          for (int k = 0; k < 3; ++k) q[k] = Vec3(footprint[c[k]].x(), footprint[c[k]].y(), 0);
+          const double signed_third = (q[1] - q[0]).cross(q[2] - q[0]).z() / 6.0;
+          for (int k = 0; k < 3; ++k) area[c[k]] += std::abs(signed_third);
+          // Folded faces (steep relief walls) get no cotangent weight: they are not part of the base.
+          if (signed_third <= 0) continue;
+        } else {
+          for (int k = 0; k < 3; ++k) q[k] = mesh.position(c[k]);
+        }
+        if (uniform) continue;
         for (int k = 0; k < 3; ++k) {
           const int i = (k + 1) % 3, j = (k + 2) % 3;
           const double half_cot = 0.5 * cotangent(q[i], q[j], q[k]);
@@ -349,10 +344,9 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
           slot(c[j], c[i]) += half_cot;
         }
       }
-    weights = &projected_weight;
-  } else {
-    for (const int v : rows) area[v] = mesh.vertex_area(v);
   }
+  if (!height_field)
+    for (const int v : rows) area[v] = mesh.vertex_area(v);
   const int dims = height_field ? 1 : 3;
   // Known values: the offset from the quadric (HeightField) or the position (Surface).
   auto value = [&](int v) -> Eigen::Vector3d {
@@ -372,7 +366,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     double diagonal = 0;
     for (std::size_t k = ring_offset_[v]; k < ring_offset_[v + 1]; ++k) {
       const int w = mesh.neighbors_begin(v)[k - ring_offset_[v]];
-      const double weight = (*weights)[k];
+      const double weight = weights[k];
       diagonal -= weight;
       if (unknown_id[w] >= 0)
         wu.emplace_back(row, unknown_id[w], weight);
@@ -407,13 +401,20 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
       rhs.row(u) += weight * value(v).head(dims).transpose();
     }
   }
+  r.timings.assembly = seconds_since(assembly_start);
   Eigen::MatrixXd X;
-  if (!solve_spd(Q, rhs, &X))
+  SpdTimings spd;
+  const bool solved = solve_spd(Q, rhs, &X, &spd);
+  r.timings.ordering = spd.ordering;
+  r.timings.factorisation = spd.factorisation;
+  r.timings.solve = spd.solve;
+  if (!solved)
     return failure(BackgroundStatus::NoRing,
                    "the background fill is singular: the region has too little background around it; segment a smaller "
                    "region or use a larger ring");
 
   // --- base positions, normals and heights.
+  const auto height_start = std::chrono::steady_clock::now();
   r.base_positions.resize(static_cast<std::size_t>(nv));
   for (int v = 0; v < nv; ++v) r.base_positions[v] = mesh.position(v);
   for (Eigen::Index u = 0; u < nu; ++u) {
@@ -453,6 +454,7 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     r.ring_max_residual = std::max(r.ring_max_residual, std::abs(r.height[v]));
   }
   r.ring_rms_residual = fitted ? std::sqrt(sum2 / static_cast<double>(fitted)) : 0.0;
+  r.timings.height = seconds_since(height_start);
   r.seconds = seconds_since(start);
   return r;
 }

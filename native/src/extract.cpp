@@ -8,10 +8,6 @@
 
 namespace relief_snake {
 
-namespace {
-
-}  // namespace
-
 std::vector<char> region_from_input_indices(const Mesh& mesh, const std::vector<std::int64_t>& input_indices,
                                             std::int64_t expected_vertices, std::vector<std::string>* notes) {
   const std::int64_t n = static_cast<std::int64_t>(mesh.input_vertex_count());
@@ -56,6 +52,20 @@ std::string ExtractResult::summary() const {
   return text;
 }
 
+std::string ExtractResult::timings_text() const {
+  const BackgroundTimings& b = background.timings;
+  const FlattenTimings& f = height_map.frame.timings;
+  char text[640];
+  std::snprintf(text, sizeof text,
+                "weights %.3f s, ring %.3f s, assembly %.3f s, ordering %.3f s, factorisation %.3f s, solve %.3f s, "
+                "height %.3f s, relief %.3f s, plane %.3f s, conformal assembly %.3f s, conformal ordering %.3f s, "
+                "conformal factorisation %.3f s, conformal solve %.3f s, conformal distortion %.3f s, rasterise %.3f s",
+                weights_seconds, b.ring, b.assembly, b.ordering, b.factorisation, b.solve, b.height, relief_seconds,
+                f.plane, f.conformal_assembly, f.conformal_ordering, f.conformal_factorisation, f.conformal_solve,
+                f.conformal_distortion, rasterise_seconds);
+  return text;
+}
+
 ExtractResult extract(const BackgroundSolver& solver, const std::vector<char>& region, double step_height,
                       const HeightMapOptions& height_map) {
   const Mesh& mesh = solver.mesh();
@@ -92,10 +102,13 @@ ExtractResult extract(const BackgroundSolver& solver, const std::vector<char>& r
     patch.heights.push_back(b.height[v]);
   }
   x.relief_heights = patch.heights;
+  x.relief_seconds = seconds_since(start);
   const Flattened flat = flatten(patch, height_map);
   x.relief_uv = flat.uv;
   const double pixel = height_map.pixel_size > 0 ? height_map.pixel_size : 0.5 * mesh.average_edge_length();
+  const auto raster_start = std::chrono::steady_clock::now();
   x.height_map = rasterise(patch, flat, pixel, height_map);
+  x.rasterise_seconds = seconds_since(raster_start);
   if (!flat.note.empty()) x.notes.push_back(flat.note);
   x.height_map_seconds = seconds_since(start);
   return x;
@@ -103,8 +116,12 @@ ExtractResult extract(const BackgroundSolver& solver, const std::vector<char>& r
 
 ExtractResult extract(const Mesh& mesh, const std::vector<char>& region, double step_height,
                       const ExtractOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   const BackgroundSolver solver(mesh, options.background);
-  return extract(solver, region, step_height, options.height_map);
+  const double weights = seconds_since(start);
+  ExtractResult x = extract(solver, region, step_height, options.height_map);
+  x.weights_seconds = weights;
+  return x;
 }
 
 }  // namespace relief_snake

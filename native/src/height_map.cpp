@@ -1,6 +1,8 @@
+#include "report_text.hpp"
 #include "relief_snake/height_map.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -128,8 +130,10 @@ std::vector<Vec2> plane_uv(const HeightPatch& patch, const Flattened& frame) {
 
 /// Least-squares conformal map with two vertices of each connected part pinned at their plane
 /// coordinates (the extremes along axis_u), then scaled about the plane centroid so the uv area
-/// equals the 3D area. Returns false if the solve fails.
-bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std::vector<Vec2>* uv) {
+/// equals the 3D area. Returns false if the solve fails. timings gets the conformal stages'.
+bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std::vector<Vec2>* uv,
+                  FlattenTimings* timings) {
+  auto start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(patch.positions.size());
   const std::size_t nt = patch.triangles.size() / 3;
   // Connected parts (union-find over triangles).
@@ -194,8 +198,16 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
   Eigen::SparseMatrix<double> A(2 * static_cast<Eigen::Index>(nt), 2 * nfree);
   A.setFromTriplets(entries.begin(), entries.end());
   const Eigen::SparseMatrix<double> AtA = A.transpose() * A;
+  const Eigen::MatrixXd Atb = A.transpose() * rhs;
+  timings->conformal_assembly = seconds_since(start);
   Eigen::MatrixXd solution;
-  if (!solve_spd(AtA, Eigen::MatrixXd(A.transpose() * rhs), &solution)) return false;
+  SpdTimings spd;
+  const bool solved = solve_spd(AtA, Atb, &solution, &spd);
+  timings->conformal_ordering = spd.ordering;
+  timings->conformal_factorisation = spd.factorisation;
+  timings->conformal_solve = spd.solve;
+  if (!solved) return false;
+  start = std::chrono::steady_clock::now();
   const Eigen::VectorXd x = solution.col(0);
   uv->resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) (*uv)[i] = pinned[i] ? plane[i] : Vec2(x[id[i]], x[nfree + id[i]]);
@@ -208,12 +220,14 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
   if (!(area2 > 0)) return false;
   const double scale = std::sqrt(area3 / area2);
   for (Vec2& q : *uv) q *= scale;  // about the plane's origin (the patch centroid)
+  timings->conformal_assembly += seconds_since(start);
   return true;
 }
 
 }  // namespace
 
 Flattened flatten(const HeightPatch& patch, const HeightMapOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   check_patch(patch);
   Flattened out;
   fit_plane(patch, &out);
@@ -229,19 +243,22 @@ Flattened flatten(const HeightPatch& patch, const HeightMapOptions& options) {
     out.note = text;
   }
   out.method = method;
+  out.timings.plane = seconds_since(start);
   if (method == Flattening::Plane) {
     out.uv = plane;
     out.distortion = plane_distortion;
     return out;
   }
-  if (!conformal_uv(patch, plane, &out.uv)) {
+  if (!conformal_uv(patch, plane, &out.uv, &out.timings)) {
     out.method = Flattening::Plane;
     out.uv = plane;
     out.distortion = plane_distortion;
     out.note += (out.note.empty() ? "" : "; ") + std::string("the conformal map failed, used the plane projection");
     return out;
   }
+  const auto distortion_start = std::chrono::steady_clock::now();
   out.distortion = measure_distortion(patch, out.uv);
+  out.timings.conformal_distortion = seconds_since(distortion_start);
   return out;
 }
 

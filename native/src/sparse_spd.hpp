@@ -8,9 +8,19 @@
 
 namespace relief_snake {
 
+/// Where one solve_spd() spent its time (wall seconds; for the stages' reports and benchmarks).
+struct SpdTimings {
+  double ordering = 0;       ///< fill-reducing ordering and symbolic analysis
+  double factorisation = 0;  ///< numeric factorisation
+  double solve = 0;          ///< triangular solves for every column of B
+};
+
 /// X (#A by #B cols) = A^-1 B for A (n by n, symmetric positive definite; both triangles
-/// stored) and B (n by k). False if the factorisation or the solve fails or X is not finite.
-bool solve_spd(const Eigen::SparseMatrix<double>& A, const Eigen::MatrixXd& B, Eigen::MatrixXd* X);
+/// stored) and B (n by k): one factorisation for all k columns. False if the factorisation or
+/// the solve fails or X is not finite. timings, if given, gets the stages' times (summed over
+/// the attempts when CHOLMOD falls back to LDL^T).
+bool solve_spd(const Eigen::SparseMatrix<double>& A, const Eigen::MatrixXd& B, Eigen::MatrixXd* X,
+               SpdTimings* timings = nullptr);
 
 /// "cholmod" or "eigen-simplicial-ldlt": which solver this build uses (for benchmarks and notes).
 const char* spd_solver_name();

@@ -1,6 +1,7 @@
 """relief-snake extract and segment --extract, run as a user would: files, sidecar, errors."""
 import json
 import struct
+import re
 import subprocess
 import zlib
 from pathlib import Path
@@ -200,6 +201,29 @@ def test_extract_from_a_result_file_with_options(cli, extracted, tmp_path):
     sidecar = json.loads((tmp_path / "x" / "height.json").read_text())
     assert sidecar["pixel_size"] == 0.5
     assert sidecar["frame"]["flattening"] == "plane"
+
+
+STAGES = ["read result", "load mesh", "weights", "ring", "assembly", "ordering", "factorisation", "solve",
+          "height", "relief", "plane", "conformal assembly", "conformal ordering", "conformal factorisation",
+          "conformal solve", "conformal distortion", "rasterise", "write"]
+
+
+def test_extract_timings_prints_every_stage_once(cli, extracted, tmp_path):
+    mesh, _, out, _ = extracted
+    r = run(cli, "extract", mesh, out / "result.json", "--out", tmp_path / "t", "--flatten", "conformal", "--timings")
+    assert r.returncode == 0, r.stderr
+    lines = [l for l in r.stdout.splitlines() if l.startswith("relief-snake: timings: ")]
+    assert len(lines) == 1, r.stdout
+    found = re.findall(r"([a-z][a-z ]*?) ([0-9.]+) s", lines[0][len("relief-snake: timings: "):])
+    assert [name for name, _ in found] == STAGES
+    seconds = dict((name, float(value)) for name, value in found)
+    # The conformal map was asked for, so its factorisation ran and took some time.
+    assert seconds["conformal factorisation"] > 0 and seconds["factorisation"] > 0
+    total = float(re.search(r"wrote .* in ([0-9.]+) s total", r.stdout).group(1))
+    assert sum(seconds.values()) <= total + 0.01
+    # Without the flag: the one summary line only.
+    plain = run(cli, "extract", mesh, out / "result.json", "--out", tmp_path / "p", "--quiet")
+    assert plain.returncode == 0 and "relief-snake: timings:" not in plain.stdout
 
 
 def one_error_line(r, code):

@@ -56,6 +56,16 @@ enum class BackgroundStatus {
 };
 const char* to_string(BackgroundStatus status);
 
+/// Where solve() spends its wall time, by stage (seconds; for benchmarks).
+struct BackgroundTimings {
+  double ring = 0;           ///< region checks and the ring (distances along edges)
+  double assembly = 0;       ///< unknowns, the model's frame, Laplacian weights, the normal equations
+  double ordering = 0;       ///< the sparse solve's fill-reducing ordering and symbolic analysis
+  double factorisation = 0;  ///< its numeric factorisation
+  double solve = 0;          ///< its triangular solves (all coordinates with one factorisation)
+  double height = 0;         ///< base positions, normals, heights and the ring residual
+};
+
 struct BackgroundResult {
   BackgroundStatus status = BackgroundStatus::Ok;
   std::string message;  ///< one line for the user when status != Ok
@@ -76,12 +86,13 @@ struct BackgroundResult {
   /// magnitude (0 when smoothing = 0: the ring is fixed).
   double ring_rms_residual = 0, ring_max_residual = 0;
   double seconds = 0;  ///< time of solve()
+  BackgroundTimings timings;
 
   bool ok() const { return status == BackgroundStatus::Ok; }
 };
 
-/// The fill for one mesh: precomputes the Laplacian weights once, so several regions (a
-/// snake's successive contours) cost one solve each.
+/// The fill for one mesh, for several regions (a snake's successive contours): each solve()
+/// computes the Laplacian weights of the faces around its region and ring only.
 class BackgroundSolver {
  public:
   explicit BackgroundSolver(const Mesh& mesh, const BackgroundOptions& options = {});
@@ -98,8 +109,7 @@ class BackgroundSolver {
  private:
   const Mesh& mesh_;
   BackgroundOptions options_;
-  /// Weight of each one-ring entry (aligned with Mesh::neighbors_begin(v)), and the vertex areas.
-  std::vector<double> edge_weight_;
+  /// Where each vertex's one-ring entries start in a flat per-entry array (#V + 1).
   std::vector<std::size_t> ring_offset_;
 };
 

@@ -40,6 +40,10 @@ struct ExtractResult {
 
   HeightMap height_map;
   double background_seconds = 0, height_map_seconds = 0;
+  /// The stages' wall times beyond background.timings and height_map.frame.timings (seconds).
+  double weights_seconds = 0;    ///< the mesh's Laplacian weights (BackgroundSolver; 0 when one was given)
+  double relief_seconds = 0;     ///< the relief's faces and the patch over the base
+  double rasterise_seconds = 0;  ///< the height map's raster
   std::vector<std::string> notes;
 
   /// Positions of the scan with the relief removed (#V): region vertices on the base, every
@@ -47,6 +51,8 @@ struct ExtractResult {
   std::vector<Vec3> background_positions(const Mesh& mesh) const;
   /// One line: region size, residual, height range, map size and flattening, times.
   std::string summary() const;
+  /// One line of every stage's time: "weights 0.031 s, ring 0.012 s, ...".
+  std::string timings_text() const;
 };
 
 /// Throws Error with a one-line message on an empty region, a region with no background

@@ -31,6 +31,17 @@ struct Distortion {
   int flipped_faces = 0;                 ///< faces whose uv image is turned over
 };
 
+/// Where flatten() spends its wall time (seconds; for benchmarks). The conformal stages stay 0
+/// when the plane projection is used.
+struct FlattenTimings {
+  double plane = 0;                    ///< best-fit plane, projection and its distortion
+  double conformal_assembly = 0;       ///< the least-squares conformal system and the final scaling
+  double conformal_ordering = 0;       ///< its fill-reducing ordering and symbolic analysis
+  double conformal_factorisation = 0;  ///< its numeric factorisation
+  double conformal_solve = 0;          ///< its triangular solves
+  double conformal_distortion = 0;     ///< the conformal map's distortion
+};
+
 /// A flattening of a patch: uv coordinates in a 3D frame (origin + u axis_u + v axis_v is
 /// where a uv point lies on the best-fit plane).
 struct Flattened {
@@ -39,6 +50,7 @@ struct Flattened {
   Vec3 origin = Vec3::Zero(), axis_u = Vec3::UnitX(), axis_v = Vec3::UnitY(), normal = Vec3::UnitZ();
   Distortion distortion;
   std::string note;  ///< why Auto chose what it chose
+  FlattenTimings timings;
 };
 
 struct HeightMapOptions {
