@@ -353,7 +353,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try, evidence_options).step_share;
       }
       const int far_index = a.evidence.step.far_point;
-      const Vec3 far_position = far_index >= 0 ? position(mesh, a.run.contour[far_index]) : Vec3::Zero();
+      const Vec3 far_position = far_index >= 0 ? mesh.to_file(position(mesh, a.run.contour[far_index])) : Vec3::Zero();
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       const bool holds = a.check.holds;
       if (first || better(a, best)) best = std::move(a);
@@ -431,7 +431,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
 
   result.contour = best.run.contour;
   result.polyline.reserve(result.contour.size());
-  for (const SurfacePoint& p : result.contour) result.polyline.push_back(position(mesh, p));
+  for (const SurfacePoint& p : result.contour) result.polyline.push_back(mesh.to_file(position(mesh, p)));
   for (std::size_t i = 0; i < mesh.input_vertex_count(); ++i) {
     const int v = mesh.input_to_mesh(i);
     if (v >= 0 && best.region[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
