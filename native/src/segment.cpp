@@ -7,6 +7,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "relief_snake/enclosure.hpp"
 #include "relief_snake/energy.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/evidence.hpp"
@@ -249,6 +250,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     }
   }
   result.relief_side = inside_left ? ReliefSide::Left : ReliefSide::Right;
+  // What the picks enclose, for the check that they go round a relief at all (enclosure.hpp).
+  const Enclosure enclosure = options.closed ? measure_enclosure(mesh, initial.path, inside_left) : Enclosure{};
 
   // With the refit on, a kept result's step must agree with its own h within x1.5: the refit
   // brings a right contour's h within x1.3, and a contour whose step keeps moving away from
@@ -389,6 +392,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     return out;
   }
   if (!best.usable()) {
+    const std::string no_relief = enclosure_reason(enclosure, h);
+    if (!no_relief.empty() && collapse_phase != "initial")
+      throw Error("the snake collapsed during the " + collapse_phase + " phase: " + no_relief);
     if (collapse_phase == "initial")
       throw Error("the picked contour is only a few step heights long; pick vertices further from the relief "
                   "or check h (" + fmt(h) + ")");
@@ -459,13 +465,22 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"far_run", step.longest_far / best.h}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
+  if (options.closed) {
+    // Picks on one side of the relief can still leave a snake that settles on something.
+    const double risen = risen_area(enclosure, EnclosureOptions().rise * best.h);
+    result.checks.push_back({"enclosed_risen_area", risen / (best.h * best.h)});
+    result.checks.push_back({"enclosed_risen_share", enclosure.enclosed_area > 0 ? risen / enclosure.enclosed_area : 0.0});
+    result.checks.push_back({"enclosed_background_residual", enclosure.background_residual / best.h});
+    const std::string no_relief = enclosure_reason(enclosure, best.h);
+    if (!no_relief.empty()) result.reasons.push_back(no_relief);
+  }
   if (best.run.hit_cap) {
     result.status = Status::IterationCap;
     result.reasons.insert(result.reasons.begin(), "a phase stopped at the iteration cap (" +
                                                       std::to_string(options.max_iterations) +
                                                       ") before the snake settled");
   } else {
-    result.status = best.check.holds ? Status::Converged : Status::Doubtful;
+    result.status = result.reasons.empty() ? Status::Converged : Status::Doubtful;
   }
   if (result.status != Status::Converged) {
     std::string message = result.status == Status::IterationCap ? "The snake did not settle: " : "Check this result: ";
