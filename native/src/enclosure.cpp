@@ -12,9 +12,13 @@ namespace relief_snake {
 Enclosure measure_enclosure(const Mesh& mesh, const SurfacePath& path, bool inside_left) {
   Enclosure out;
   if (path.size() < 3) return out;
-  // The same background as the step-height estimate's: a quadric along the contour's band.
-  const PolynomialBackground background = fit_polynomial_background(mesh, contour_band_vertices(mesh, path, 2), 2);
-  out.background_residual = background.residual;
+  // A quadric through the corners of the contour's own faces, fitted robustly (Tukey): the step-height
+  // estimate's band of two more rings reaches the relief on coarse meshes (picks 3 h out are two
+  // edges from it at 2,600 triangles), and a contour that runs over a piece of the relief must not
+  // lift the background either.
+  const std::vector<int> samples = contour_band_vertices(mesh, path, 0);
+  const PolynomialBackground background = fit_robust_background(mesh, samples).background;
+  out.background_residual = fit_polynomial_background(mesh, samples, 2).residual;  // plain: how well it fits
   const std::vector<char> region = relief_region(mesh, path, true, inside_left);
   for (int v = 0; v < mesh.n_vertices(); ++v)
     if (region[v]) {
@@ -37,7 +41,7 @@ std::string enclosure_reason(const Enclosure& enclosure, double h, const Enclosu
   if (risen >= options.min_area * h * h || risen >= options.min_share * enclosure.enclosed_area) return "";
   char text[64];
   std::snprintf(text, sizeof text, "%.3g", h);
-  return std::string("nothing the picks enclose rises half a step (h = ") + text +
+  return std::string("nothing the picks enclose rises half a step (") + text +
          ") above the background along them: they may all lie on one side of the relief or on it (a cluster, "
          "an arc, a ring beside it); pick points on the background all around the relief";
 }

@@ -466,13 +466,21 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (options.closed) {
-    // Picks on one side of the relief can still leave a snake that settles on something.
-    const double risen = risen_area(enclosure, EnclosureOptions().rise * best.h);
-    result.checks.push_back({"enclosed_risen_area", risen / (best.h * best.h)});
+    // Picks on one side of the relief can still leave a snake that settles on something. Judged
+    // with the step found along the contour where it is lower than h (a rough h given too large,
+    // or a background the quadric follows only roughly: the step is there, the snake measured it).
+    const double found = best.evidence.step.step_height;
+    const double judged = found > 0 ? std::min(best.h, found) : best.h;
+    const double risen = risen_area(enclosure, EnclosureOptions().rise * judged);
+    result.checks.push_back({"enclosed_risen_area", risen / (judged * judged)});
     result.checks.push_back({"enclosed_risen_share", enclosure.enclosed_area > 0 ? risen / enclosure.enclosed_area : 0.0});
     result.checks.push_back({"enclosed_background_residual", enclosure.background_residual / best.h});
-    const std::string no_relief = enclosure_reason(enclosure, best.h);
-    if (!no_relief.empty()) result.reasons.push_back(no_relief);
+    // Named when nothing else is wrong (a snake holding on texture or noise inside picks beside the
+    // relief), or when the snake found little step either; a contour mostly on a step with picks
+    // that "enclose nothing" says more about the quadric (a wavy background under a wide ring).
+    const std::string no_relief = enclosure_reason(enclosure, judged);
+    if (!no_relief.empty() && (result.reasons.empty() || best.evidence.step.step_share < 0.5))
+      result.reasons.push_back(no_relief);
   }
   if (best.run.hit_cap) {
     result.status = Status::IterationCap;

@@ -6,9 +6,9 @@
 // shrinks onto texture or onto nothing and, without this check, could end "converged" on the
 // background with no warning.
 //
-// The test is the step-height estimate's view of the picks (step_height.hpp): a smooth
-// background (a quadric) fitted along the initial contour and continued under it, and the
-// heights above it of the vertices the contour encloses. A relief of step h inside shows as
+// The test is close to the step-height estimate's view of the picks (step_height.hpp): a smooth
+// background (a quadric, fitted robustly to the corners of the initial contour's faces) continued
+// under the contour, and the heights above it of the vertices the contour encloses. A relief of step h inside shows as
 // area standing at least half an h above that background; picks on one side show none (or
 // only a sliver at the contour, where it runs onto the relief).
 #include <string>
@@ -32,7 +32,7 @@ struct EnclosureOptions {
 struct Enclosure {
   std::vector<WeightedHeight> heights;  ///< the enclosed vertices' heights (weight: vertex area)
   double enclosed_area = 0;             ///< their area
-  double background_residual = 0;       ///< RMS residual of the background fit along the contour
+  double background_residual = 0;       ///< RMS residual of a plain least-squares quadric along the contour
 };
 
 /// path: the closed initial contour; inside_left: its enclosed side (contour_orientation_left()).
@@ -41,8 +41,8 @@ Enclosure measure_enclosure(const Mesh& mesh, const SurfacePath& path, bool insi
 /// Area of the enclosed vertices standing at least `rise` above the background.
 double risen_area(const Enclosure& enclosure, double rise);
 
-/// For step height h: the reason (one sentence, for Result::reasons) when the picks enclose no
-/// relief, or "" when they do.
+/// For step height h (segment() passes the h used, or the step found along the contour where that is
+/// lower): the reason (one sentence, for Result::reasons) when the picks enclose no relief, or "".
 std::string enclosure_reason(const Enclosure& enclosure, double h, const EnclosureOptions& options = {});
 
 }  // namespace relief_snake
