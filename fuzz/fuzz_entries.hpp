@@ -12,9 +12,11 @@ namespace relief_snake::fuzz {
 /// rest is the file's bytes, read by read_mesh_bytes and built by Mesh::from_soup.
 void mesh_intake(const std::uint8_t* data, std::size_t size);
 
-/// A small height-field mesh (3..12 by 3..12 vertices, heights from the bytes), then
-/// 2..6 picks and the main options from the bytes, then segment() capped at a few
-/// iterations per phase.
+/// segment() on small meshes: byte 0 picks one of six fixed 10 x 10 height fields (a sharp,
+/// a blended and a ring-shaped disk, a step to the boundary, a disk on a tilted wavy background,
+/// a flat field; built once) or a 3..8 by 3..8 field with heights from the bytes; then 2..7
+/// picks, flags (closed, side, foot snap, holes, refit, auto h, extras), planarity options, h,
+/// W_int, 1..5 iterations per phase, a cancel point, and band or hole picks.
 void segment_small(const std::uint8_t* data, std::size_t size);
 
 }  // namespace relief_snake::fuzz

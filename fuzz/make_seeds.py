@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the fuzzers' seed corpus: small valid files of every format (fuzz/corpus/intake/),
-each prefixed with the format byte of fuzz_entries.hpp, and segment inputs that make a
-bump with picks around it (fuzz/corpus/segment/). Deterministic; rerun to regenerate."""
+each prefixed with the format byte of fuzz_entries.hpp, and segment inputs with picks around
+the relief of each fixed mesh and each option group (fuzz/corpus/segment/). Deterministic; rerun to regenerate."""
 import os
 import struct
 
@@ -91,18 +91,51 @@ def main():
     for name, (selector, data) in seeds.items():
         with open(os.path.join(out, name), "wb") as f:
             f.write(bytes([selector]) + data)
-    # segment: nx, ny, heights, n_picks, picks (u16), flags, h, w_int, max_iterations
+    # segment (fuzz_entries.hpp): mesh, [nx, ny, heights], n_picks, picks (u16, index + 1), flags, more,
+    # h, w_int, iterations, cancel, extras, [band or hole picks]
     seg = os.path.join(HERE, "corpus", "segment")
     os.makedirs(seg, exist_ok=True)
-    for name, n, flags in [("closed_bump", 8, 0), ("open_side", 7, 1), ("foot_snap", 9, 4)]:
-        nx = ny = n
-        heights = bytes(12 if 2 <= i <= n - 3 and 2 <= j <= n - 3 else 0 for j in range(ny) for i in range(nx))
-        ring = [(1, 1), (n - 2, 1), (n - 2, n - 2), (1, n - 2)]
-        picks = b"".join(struct.pack("<H", j * nx + i + 1) for i, j in ring)
-        data = bytes([nx - 3, ny - 3]) + heights + bytes([len(ring) - 2]) + picks + bytes([flags, 150, 63, 30])
+    for old in os.listdir(seg):
+        os.remove(os.path.join(seg, old))
+
+    def picks(points, nx=10):
+        return bytes([len(points) - 2]) + b"".join(struct.pack("<H", j * nx + i + 1) for i, j in points)
+
+    def ring_picks(points, nx=10):
+        return bytes([len(points) - 3]) + b"".join(struct.pack("<H", j * nx + i + 1) for i, j in points)
+
+    ring = [(1, 1), (8, 1), (8, 8), (1, 8)]
+    h1, w, iters = 101, 63, 4  # h = 0.05 * 1.03^101 = 1 edge; W_int 0.25; 5 iterations per phase
+    cases = {
+        "sharp_disk": (0, ring, 0, 0),
+        "blended_disk": (1, ring, 0, 0),
+        "ring_disk": (2, ring, 0, 0),
+        "step_closed": (3, ring, 0, 0),
+        "tilted_disk": (4, ring, 0, 0),
+        "flat": (5, ring, 0, 0),
+        "open_auto_side": (3, [(4, 0), (4, 5), (4, 9)], 1 | 4, 0),
+        "foot_snap": (1, ring, 8, 0),
+        "auto_h": (0, ring, 64, 0),
+        "geodesic_vertices": (0, ring, 0, 1 | 4),
+        "euclidean_area_levels": (4, ring, 0, 2 | 8 | 32),
+        "exact_q_barrier": (1, ring, 16 | 32, 64 | 128),
+    }
+    for name, (mesh, points, flags, more) in cases.items():
+        data = bytes([mesh]) + picks(points) + bytes([flags, more, h1, w, iters, 0, 2])
         with open(os.path.join(seg, name), "wb") as f:
             f.write(data)
-
+    # A band (a second ring inside the first) and hole picks on the ring-shaped disk.
+    inner = [(4, 4), (5, 4), (5, 5), (4, 5)]
+    with open(os.path.join(seg, "band"), "wb") as f:
+        f.write(bytes([2]) + picks(ring) + bytes([128, 0, h1, w, iters, 0, 0]) + ring_picks(inner))
+    with open(os.path.join(seg, "hole_picks"), "wb") as f:
+        f.write(bytes([2]) + picks(ring) + bytes([128, 0, h1, w, iters, 0, 1]) + ring_picks(inner))
+    # A mesh from the bytes: an 8 x 8 bump, picks around it.
+    n = 8
+    heights = bytes(12 if 2 <= i <= n - 3 and 2 <= j <= n - 3 else 0 for j in range(n) for i in range(n))
+    own_ring = [(1, 1), (n - 2, 1), (n - 2, n - 2), (1, n - 2)]
+    with open(os.path.join(seg, "own_bump"), "wb") as f:
+        f.write(bytes([6, n - 3, n - 3]) + heights + picks(own_ring, n) + bytes([0, 0, 150, w, iters, 0, 2]))
 
 if __name__ == "__main__":
     main()

@@ -4,19 +4,24 @@
 # RSS and 2 GB per allocation, 60 s per input (a single segment() on a small mesh takes ~0.05 s
 # natively, but ASan+UBSan on a loaded 2-core machine has been seen at 12 s). Exits non-zero on any finding, whose input is
 # written to $FUZZ_DIR/findings/<target>/ (add it to fuzz/regression/<target>/).
+# FUZZ_TARGETS (default "mesh_intake segment") picks the libFuzzer targets, FUZZ_ATHERIS=0 skips the
+# module harness. Every run appends one line per target to $FUZZ_DIR/campaign.log (date, target,
+# seconds, executions, corpus size): `make fuzz-campaign` sums them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 FUZZ_SECONDS=${FUZZ_SECONDS:-60}
 FUZZ_DIR=${FUZZ_DIR:-build-fuzz}
 JOBS=${JOBS:-2}
 PYTHON=${PYTHON:-python3}
+FUZZ_TARGETS=${FUZZ_TARGETS:-mesh_intake segment}
+FUZZ_ATHERIS=${FUZZ_ATHERIS:-1}
 
 cmake -S . -B "$FUZZ_DIR" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DRELIEF_SNAKE_FUZZ=ON -DRELIEF_SNAKE_BUILD_TESTS=OFF -DRELIEF_SNAKE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$FUZZ_DIR" -j "$JOBS" --target fuzz_mesh_intake fuzz_segment
 
 status=0
-for target in mesh_intake segment; do
+for target in $FUZZ_TARGETS; do
   corpus_name=$([ "$target" = mesh_intake ] && echo intake || echo segment)
   work="$FUZZ_DIR/corpus/$corpus_name"
   findings="$FUZZ_DIR/findings/$corpus_name"
@@ -33,7 +38,9 @@ for target in mesh_intake segment; do
   fi
   execs=$(grep -o "stat::number_of_executed_units: *[0-9]*" "$log" | grep -o "[0-9]*$" || echo "?")
   echo "fuzz: $target: $execs executions, corpus $(ls "$work" | wc -l) inputs"
+  echo "$(date -u +%Y-%m-%dT%H:%M:%SZ) $target $FUZZ_SECONDS $execs $(ls "$work" | wc -l)" >>"$FUZZ_DIR/campaign.log"
 done
+if [ "$FUZZ_ATHERIS" = 0 ]; then exit $status; fi
 # The module's argument handling (atheris; the module from $BUILD_DIR, not instrumented).
 BUILD_DIR=${BUILD_DIR:-build}
 log="$FUZZ_DIR/atheris_module.log"

@@ -199,6 +199,8 @@ int run_info(const std::vector<std::string>& args) {
             << "boundary edges: " << r.boundary_edges << "\n"
             << "average edge length: " << mesh.average_edge_length() << "\n"
             << "bounding box diagonal: " << mesh.bbox_diagonal() << "\n"
+            << "local origin: " << mesh.origin().x() << " " << mesh.origin().y() << " " << mesh.origin().z()
+            << " (subtracted inside the engine; results are in the file's coordinates)\n"
             << "load seconds: " << load_seconds << "\n";
   return 0;
 }

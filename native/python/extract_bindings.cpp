@@ -106,7 +106,8 @@ py::dict run_extract(py::object vertices, py::object triangles, py::object relie
   for (std::size_t i = 0; i < n_input; ++i) {
     const int v = mesh->input_to_mesh(i);
     const bool moved = v >= 0 && x.background.region[v];
-    for (int k = 0; k < 3; ++k) base.append(moved ? x.background.base_positions[v][k] : V[3 * i + k]);
+    const Vec3 moved_to = moved ? mesh->to_file(x.background.base_positions[v]) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k) base.append(moved ? moved_to[k] : V[3 * i + k]);
     heights.append(v >= 0 ? x.background.height[v] : 0.0);
   }
   py::list relief_inputs, relief_triangles, relief_heights, relief_uv;

@@ -277,8 +277,8 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
   }
   result.contour = best.first.run.contour;
   result.band_contour = best.second.run.contour;
-  for (const SurfacePoint& p : result.contour) result.polyline.push_back(position(mesh, p));
-  for (const SurfacePoint& p : result.band_contour) result.band_polyline.push_back(position(mesh, p));
+  for (const SurfacePoint& p : result.contour) result.polyline.push_back(mesh.to_file(position(mesh, p)));
+  for (const SurfacePoint& p : result.band_contour) result.band_polyline.push_back(mesh.to_file(position(mesh, p)));
   for (std::size_t i = 0; i < mesh.input_vertex_count(); ++i) {
     const int v = mesh.input_to_mesh(i);
     if (v >= 0 && best.region[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));

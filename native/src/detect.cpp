@@ -293,7 +293,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
         grow(mesh, raw[c].vertices, std::max(options.outline_offset * h, 3 * edge),
              [&](int w) { return label[w] >= 0 && label[w] != self; });
     const std::vector<int> loop = region_outer_loop(mesh, grown);
-    for (const int v : loop) cand.outline.push_back(mesh.position(v));
+    for (const int v : loop) cand.outline.push_back(mesh.to_file(mesh.position(v)));
     for (const int v : picks_along(mesh, loop, std::max(options.pick_spacing * h, 4 * edge)))
       cand.picks.push_back(static_cast<std::int64_t>(mesh.mesh_to_input(v)));
     if (options.refine) {

@@ -217,7 +217,11 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
       p.phase = phase.name;
       p.iteration = iteration;
       p.snaxels = snake.size();
-      p.contour = [&snake] { return snake.polyline(); };
+      p.contour = [&snake] {  // in file coordinates, like every result
+        std::vector<Vec3> line = snake.polyline();
+        for (Vec3& q : line) q = snake.mesh().to_file(q);
+        return line;
+      };
       if (!progress(p)) {
         outcome.cancelled = true;
         return outcome;

@@ -36,7 +36,8 @@ std::vector<char> region_from_input_indices(const Mesh& mesh, const std::vector<
 
 std::vector<Vec3> ExtractResult::background_positions(const Mesh& mesh) const {
   std::vector<Vec3> out(static_cast<std::size_t>(mesh.n_vertices()));
-  for (int v = 0; v < mesh.n_vertices(); ++v) out[v] = background.region[v] ? background.base_positions[v] : mesh.position(v);
+  for (int v = 0; v < mesh.n_vertices(); ++v)
+    out[v] = mesh.to_file(background.region[v] ? background.base_positions[v] : mesh.position(v));
   return out;
 }
 
@@ -109,6 +110,7 @@ ExtractResult extract(const BackgroundSolver& solver, const std::vector<char>& r
   const auto raster_start = std::chrono::steady_clock::now();
   x.height_map = rasterise(patch, flat, pixel, height_map);
   x.rasterise_seconds = seconds_since(raster_start);
+  x.height_map.frame.origin = mesh.to_file(x.height_map.frame.origin);  // uv are relative to it: unchanged
   if (!flat.note.empty()) x.notes.push_back(flat.note);
   x.height_map_seconds = seconds_since(start);
   return x;

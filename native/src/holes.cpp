@@ -470,7 +470,7 @@ void add_holes(const Mesh& mesh, const HoleSearch& search, Result* result, SelfC
     if (hole.contour.empty()) continue;
     ++found;
     std::vector<Vec3> polyline;
-    for (const SurfacePoint& p : hole.contour) polyline.push_back(position(mesh, p));
+    for (const SurfacePoint& p : hole.contour) polyline.push_back(mesh.to_file(position(mesh, p)));
     result->holes.push_back(hole.contour);
     result->hole_polylines.push_back(std::move(polyline));
     const StepEvidence& step = hole.evidence.step;

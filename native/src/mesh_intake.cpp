@@ -400,7 +400,7 @@ Mesh Mesh::build(const Input& in, const IntakeOptions& options) {
   }
 
   // --- flat arrays -----------------------------------------------------------
-  if (options.local_origin) {
+  if (options.local_origin != LocalOrigin::Off) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (std::size_t i = 0; i < nv; ++i)
       if (mesh_id[rep[i]] >= 0) {
@@ -408,7 +408,13 @@ Mesh Mesh::build(const Input& in, const IntakeOptions& options) {
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
       }
-    mesh.origin_ = 0.5 * (lo + hi);
+    for (int k = 0; k < 3 && lo[k] <= hi[k]; ++k) {
+      const double c = 0.5 * lo[k] + 0.5 * hi[k];  // no overflow near kMaxCoordinate
+      // Auto: only where every coordinate x of the axis lies in [c / 2, 2 c] (or [2 c, c / 2]):
+      // then x - c is exact, and adding c back gives x.
+      const bool exact = c > 0 ? lo[k] >= 0.5 * c && hi[k] <= 2 * c : c < 0 && hi[k] <= 0.5 * c && lo[k] >= 2 * c;
+      if (options.local_origin == LocalOrigin::On || exact) mesh.origin_[k] = c;
+    }
   }
   const int n_mesh_vertices = static_cast<int>(om.n_vertices());
   mesh.input_to_mesh_.resize(nv);

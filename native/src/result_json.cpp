@@ -26,6 +26,7 @@ json mesh_report_json(const Mesh& mesh, const std::string& path) {
               {"boundary_edges", r.boundary_edges},
               {"average_edge_length", mesh.average_edge_length()},
               {"bbox_diagonal", mesh.bbox_diagonal()},
+              {"local_origin", {mesh.origin().x(), mesh.origin().y(), mesh.origin().z()}},
               {"summary", r.summary()}};
 }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "relief_snake/enclosure.hpp"
 #include "relief_snake/energy.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/background_inside.hpp"
@@ -254,6 +255,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     }
   }
   result.relief_side = inside_left ? ReliefSide::Left : ReliefSide::Right;
+  // What the picks enclose, for the check that they go round a relief at all (enclosure.hpp).
+  const Enclosure enclosure = options.closed ? measure_enclosure(mesh, initial.path, inside_left) : Enclosure{};
 
   // With the refit on, a kept result's step must agree with its own h within x1.5: the refit
   // brings a right contour's h within x1.3, and a contour whose step keeps moving away from
@@ -344,7 +347,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.evidence.other_side_share = measure_step(mesh, a.run.contour, other, h_try, evidence_options).step_share;
       }
       const int far_index = a.evidence.step.far_point;
-      const Vec3 far_position = far_index >= 0 ? position(mesh, a.run.contour[far_index]) : Vec3::Zero();
+      const Vec3 far_position = far_index >= 0 ? mesh.to_file(position(mesh, a.run.contour[far_index])) : Vec3::Zero();
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       // The region-wide check only where the contour-wise one holds (a fill per attempt costs about
       // as much as a refinement on large regions), and for the repair of a region that took in
@@ -384,7 +387,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
             a.evidence.background_area = second.area / (h_try * h_try);
           }
         }
-        if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.position(inside.deepest_vertex);
+        if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.to_file(mesh.position(inside.deepest_vertex));
         if (inside_out) *inside_out = std::move(inside);
         a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       }
@@ -474,6 +477,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     return out;
   }
   if (!best.usable()) {
+    const std::string no_relief = enclosure_reason(enclosure, h);
+    if (!no_relief.empty() && collapse_phase != "initial")
+      throw Error("the snake collapsed during the " + collapse_phase + " phase: " + no_relief);
     if (collapse_phase == "initial")
       throw Error("the picked contour is only a few step heights long; pick vertices further from the relief "
                   "or check h (" + fmt(h) + ")");
@@ -516,7 +522,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
 
   result.contour = best.run.contour;
   result.polyline.reserve(result.contour.size());
-  for (const SurfacePoint& p : result.contour) result.polyline.push_back(position(mesh, p));
+  for (const SurfacePoint& p : result.contour) result.polyline.push_back(mesh.to_file(position(mesh, p)));
   for (std::size_t i = 0; i < mesh.input_vertex_count(); ++i) {
     const int v = mesh.input_to_mesh(i);
     if (v >= 0 && best.region[v]) result.relief_vertices.push_back(static_cast<std::int64_t>(i));
@@ -546,13 +552,30 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"background_area", best.evidence.background_area}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
+  if (options.closed) {
+    // Picks on one side of the relief can still leave a snake that settles on something. Judged
+    // with the step found along the contour where it is lower than h (a rough h given too large,
+    // or a background the quadric follows only roughly: the step is there, the snake measured it).
+    const double found = best.evidence.step.step_height;
+    const double judged = found > 0 ? std::min(best.h, found) : best.h;
+    const double risen = risen_area(enclosure, EnclosureOptions().rise * judged);
+    result.checks.push_back({"enclosed_risen_area", risen / (judged * judged)});
+    result.checks.push_back({"enclosed_risen_share", enclosure.enclosed_area > 0 ? risen / enclosure.enclosed_area : 0.0});
+    result.checks.push_back({"enclosed_background_residual", enclosure.background_residual / best.h});
+    // Named when nothing else is wrong (a snake holding on texture or noise inside picks beside the
+    // relief), or when the snake found little step either; a contour mostly on a step with picks
+    // that "enclose nothing" says more about the quadric (a wavy background under a wide ring).
+    const std::string no_relief = enclosure_reason(enclosure, judged);
+    if (!no_relief.empty() && (result.reasons.empty() || best.evidence.step.step_share < 0.5))
+      result.reasons.push_back(no_relief);
+  }
   if (best.run.hit_cap) {
     result.status = Status::IterationCap;
     result.reasons.insert(result.reasons.begin(), "a phase stopped at the iteration cap (" +
                                                       std::to_string(options.max_iterations) +
                                                       ") before the snake settled");
   } else {
-    result.status = best.check.holds ? Status::Converged : Status::Doubtful;
+    result.status = result.reasons.empty() ? Status::Converged : Status::Doubtful;
   }
   if (result.status != Status::Converged) {
     std::string message = result.status == Status::IterationCap ? "The snake did not settle: " : "Check this result: ";

@@ -48,13 +48,7 @@ std::vector<char> near_samples(const Mesh& mesh, const std::vector<int>& samples
 
 }  // namespace
 
-StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& path, bool closed, bool inside_left,
-                                        const StepHeightOptions& options) {
-  StepHeightEstimate estimate;
-  estimate.relief_left = inside_left;
-  if (path.size() < 2) return estimate;
-
-  // Background samples: the corners of the path's faces and a few rings around them.
+std::vector<int> contour_band_vertices(const Mesh& mesh, const SurfacePath& path, int rings) {
   std::vector<char> taken(mesh.n_vertices(), 0);
   std::vector<int> samples;
   for (const SurfacePoint& p : path)
@@ -62,13 +56,24 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
       const int v = mesh.face_vertex(p.face, k);
       if (!taken[v]) taken[v] = 1, samples.push_back(v);
     }
-  for (int ring = 0, from = 0; ring < options.band_rings; ++ring) {
+  for (int ring = 0, from = 0; ring < rings; ++ring) {
     const int to = static_cast<int>(samples.size());
     for (int i = from; i < to; ++i)
       for (const int* w = mesh.neighbors_begin(samples[i]); w != mesh.neighbors_end(samples[i]); ++w)
         if (!taken[*w]) taken[*w] = 1, samples.push_back(*w);
     from = to;
   }
+  return samples;
+}
+
+StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& path, bool closed, bool inside_left,
+                                        const StepHeightOptions& options) {
+  StepHeightEstimate estimate;
+  estimate.relief_left = inside_left;
+  if (path.size() < 2) return estimate;
+
+  // Background samples: the corners of the path's faces and a few rings around them.
+  const std::vector<int> samples = contour_band_vertices(mesh, path, options.band_rings);
   const QuadraticBackground background = fit_background(mesh, samples);
   estimate.background_residual = background.residual;
 

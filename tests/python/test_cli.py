@@ -168,6 +168,49 @@ def test_segment_synthetic_scan(cli, build_dir, tmp_path):
     assert recall >= 0.8, (precision, recall)
 
 
+def scan_positions(ply):
+    """Vertex positions of a make-scan PLY (binary little-endian, float x y z)."""
+    import struct
+    data = Path(ply).read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    assert [l for l in header if l.startswith("property float")] == ["property float x", "property float y",
+                                                                     "property float z"]
+    n = int(next(l for l in header if l.startswith("element vertex")).split()[2])
+    return [struct.unpack_from("<3f", data, end + 12 * k) for k in range(n)]
+
+
+def test_segment_names_picks_on_one_side_of_the_relief(cli, build_dir, tmp_path):
+    """Picks that all lie beside the relief (issue 11): an error or a doubtful result that says so."""
+    make_scan = build_dir / "make-scan"
+    results = {}
+    for name, noise in (("clean", "0"), ("noisy", "0.1")):
+        prefix = tmp_path / name
+        r = subprocess.run([str(make_scan), "--shape", "disk", "--triangles", "20000", "--noise", noise,
+                            "--out", str(prefix)], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        P = scan_positions(f"{prefix}.ply")
+
+        def ring(x0, r0, n):  # n picks on a ring of radius r0 around (x0, 0); the disk has radius 12
+            return ",".join(str(min(range(len(P)), key=lambda v: (P[v][0] - x0 - r0 * math.cos(2 * math.pi * k / n)) ** 2
+                                    + (P[v][1] - r0 * math.sin(2 * math.pi * k / n)) ** 2)) for k in range(n))
+
+        out = tmp_path / f"{name}.json"
+        picks = ring(19.2, 1.8, 5) if name == "clean" else ring(22.8, 7.2, 6)
+        results[name] = run(cli, "segment", f"{prefix}.ply", "--picks", picks, "--step-height", "1", "--quiet",
+                            "--out", out), out
+    # A tight cluster beside the relief: the snake finds nothing, and the error says why.
+    line = assert_one_error_line(results["clean"][0], 1)
+    assert "nothing the picks enclose rises half a step" in line and "all around the relief" in line, line
+    # A ring beside it on a noisy scan: the snake settles on the noise; doubtful (exit 3) with the reason.
+    r, out = results["noisy"]
+    assert r.returncode == 3, r.stderr
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "doubtful"
+    assert any("nothing the picks enclose rises half a step" in reason for reason in doc["reasons"]), doc["reasons"]
+    assert doc["checks"]["enclosed_risen_area"] == 0.0
+
+
 ADVANCED_OPTIONS = ["tau", "epsilon", "q_samples", "exact_q", "max_turn_degrees", "lock_interval",
                     "feature_contrast", "scale_feature_with_spacing", "convex_barrier", "remove_loops",
                     "nearest_resampling", "neighbourhood", "plane_fit", "planarity_one_ring", "threads"]

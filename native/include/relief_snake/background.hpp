@@ -74,8 +74,9 @@ struct BackgroundResult {
   std::vector<char> region;  ///< #V: 1 for the region's vertices
   std::vector<int> region_vertices;  ///< the region's mesh vertices, ascending
   std::vector<int> ring_vertices;    ///< the fitted background ring's mesh vertices, ascending
-  /// #V: the base surface. Region and ring vertices: the fitted smooth surface; every other
-  /// vertex: its own position (bit-identical).
+  /// #V: the base surface, in the mesh's coordinates (like Mesh::position; Mesh::to_file gives the
+  /// file's). Region and ring vertices: the fitted smooth surface; every other vertex: its own
+  /// position (bit-identical).
   std::vector<Vec3> base_positions;
   /// #V: unit normals of the base surface (area-weighted over its faces), oriented like the mesh.
   std::vector<Vec3> base_normals;

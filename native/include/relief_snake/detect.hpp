@@ -76,7 +76,7 @@ struct DetectCandidate {
   double height = 0;                    ///< its median height above the background (the h it is refined with)
   int plateau = 0;                      ///< 0: a whole component; 1 / 2: lower / upper plateau of a split one
   std::vector<std::int64_t> picks;      ///< the outline picks the snake started from (input indices)
-  std::vector<Vec3> outline;            ///< the grown candidate's boundary the picks were taken from
+  std::vector<Vec3> outline;            ///< the grown candidate's boundary the picks were taken from (file coordinates)
   GroupOutcome refined;                 ///< the snake's result (refined.ok false: refine off, or the error)
   /// 0..1: refined: the contour's step share x the area IoU of the refined region with the
   /// component (two independent views agreeing); not refined: 0.

@@ -113,7 +113,7 @@ struct ContourEvidence {
   /// depth and area, and the floor under the depth threshold (two average edges, in h).
   bool background_measured = false;
   double background_depth = 0, background_area = 0, background_depth_floor = 0;
-  Vec3 background_where = Vec3::Zero();  ///< the deepest point of that piece
+  Vec3 background_where = Vec3::Zero();  ///< the deepest point of that piece (the file's coordinates)
 };
 
 /// The verdict on one contour.

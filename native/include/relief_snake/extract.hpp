@@ -38,7 +38,7 @@ struct ExtractResult {
   std::vector<double> relief_heights;     ///< #R: height above the base
   std::vector<Vec2> relief_uv;            ///< #R: where each relief vertex lies in the height map's frame
 
-  HeightMap height_map;
+  HeightMap height_map;  ///< its frame's origin in file coordinates
   double background_seconds = 0, height_map_seconds = 0;
   /// The stages' wall times beyond background.timings and height_map.frame.timings (seconds).
   double weights_seconds = 0;    ///< the mesh's Laplacian weights (BackgroundSolver; 0 when one was given)
@@ -46,8 +46,9 @@ struct ExtractResult {
   double rasterise_seconds = 0;  ///< the height map's raster
   std::vector<std::string> notes;
 
-  /// Positions of the scan with the relief removed (#V): region vertices on the base, every
-  /// other vertex its own position, bit for bit.
+  /// Positions of the scan with the relief removed (#V), in file coordinates (Mesh::to_file):
+  /// region vertices on the base, every other vertex its own position (bit for bit unless the
+  /// mesh was read with LocalOrigin::On).
   std::vector<Vec3> background_positions(const Mesh& mesh) const;
   /// One line: region size, residual, height range, map size and flattening, times.
   std::string summary() const;

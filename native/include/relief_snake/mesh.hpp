@@ -17,18 +17,28 @@ namespace relief_snake {
 
 using Vec3 = Eigen::Vector3d;
 
+/// IntakeOptions::local_origin: whether the mesh stores positions relative to a local origin
+/// (Mesh::origin()) instead of the file's. The engine's sums of squares (plane fits, moments)
+/// lose detail when coordinates are large against the mesh (georeferenced scans, 1e6 mm);
+/// relative to the bounding-box centre they keep it. Every result (polylines, progress
+/// contours, outlines, extraction meshes and frames) comes back in file coordinates.
+enum class LocalOrigin {
+  /// Per axis, the bounding-box centre c where the box lies within [c / 2, 2 c] (it is at least
+  /// its own extent away from zero): there x - c is exact (Sterbenz), so file coordinates come
+  /// back bit for bit; elsewhere nothing is gained and the axis is left as it is.
+  Auto,
+  On,   ///< the bounding-box centre on every axis (not always exact: x - c rounds)
+  Off,  ///< positions are the file's coordinates
+};
+
 /// How strict intake is.
 struct IntakeOptions {
   /// Skip (and count) faces with out-of-range corners or non-finite / too-large corner coordinates,
   /// and keep the readable part of a truncated or inconsistent file (MeshReport::notes says what
   /// was skipped). Off: any of these is an error that names the face, vertex or line.
   bool allow_partial = false;
-  /// Store positions relative to the bounding-box centre of the valid vertices (origin()), for
-  /// coordinates far beyond the mesh's size. At +1e6 doubles in file coordinates segment like the
-  /// scan at the origin (test_mesh_offset); this is for larger offsets, where the engine's
-  /// plane-fit moment sums (sums of squares) lose the detail. Off by default: the Segmenter does
-  /// not add origin() back to its 3D results yet, so a caller that sets it must do that.
-  bool local_origin = false;
+  /// Where positions are measured from (origin()): see LocalOrigin.
+  LocalOrigin local_origin = LocalOrigin::Auto;
 };
 
 /// Coordinates beyond this magnitude are refused: squared distances would overflow a double.
@@ -81,11 +91,13 @@ class Mesh {
   int n_vertices() const { return static_cast<int>(positions_.size()); }
   int n_faces() const { return static_cast<int>(face_vertices_.size() / 3); }
 
-  /// Position of vertex v: file coordinates minus origin().
+  /// Position of vertex v, relative to origin(): the engine works in these coordinates.
   const Vec3& position(int v) const { return positions_[v]; }
-  /// What was subtracted from the input's coordinates (zero unless IntakeOptions::local_origin):
-  /// file coordinates are position(v) + origin().
+  /// What was subtracted from the input's coordinates (IntakeOptions::local_origin; zero for a
+  /// scan around the file's origin): file coordinates are position(v) + origin().
   const Vec3& origin() const { return origin_; }
+  /// A point in the mesh's coordinates (position(), position(mesh, SurfacePoint)) in the file's.
+  Vec3 to_file(const Vec3& p) const { return p + origin_; }
   /// Corner k (0..2) of face f, counter-clockwise seen from the normal.
   int face_vertex(int f, int k) const { return face_vertices_[3 * f + k]; }
   /// All corners, 3 per face (F #F by 3, row-major), for inner loops.

@@ -126,7 +126,8 @@ struct Result {
   Status status = Status::Converged;
   bool closed = true;
   std::vector<SurfacePoint> contour;     ///< final snaxels, in order
-  std::vector<Vec3> polyline;            ///< their 3D positions
+  /// Their 3D positions in file coordinates (Mesh::to_file; as are hole_polylines and band_polyline).
+  std::vector<Vec3> polyline;
   std::vector<std::int64_t> relief_vertices;  ///< input vertex indices inside the contour (or on the relief side)
   ReliefSide relief_side = ReliefSide::Left;  ///< open contours: the side used (given or decided)
   std::vector<PhaseStats> phases;
@@ -159,8 +160,8 @@ struct Progress {
   const char* phase = "";
   int iteration = 0;
   int snaxels = 0;
-  /// The snake's current 3D polyline, built on each call (O(snaxels)): call it only
-  /// when it is drawn.
+  /// The snake's current 3D polyline in file coordinates, built on each call (O(snaxels)):
+  /// call it only when it is drawn.
   std::function<std::vector<Vec3>()> contour;
 };
 /// Called once per iteration; return false to cancel.

@@ -31,6 +31,9 @@ struct StepHeightEstimate {
   double left_rise = 0, right_rise = 0;  ///< open contours: the 90% height on each side
 };
 
+/// The background samples along a path: the corners of its faces and `rings` rings of vertices around them.
+std::vector<int> contour_band_vertices(const Mesh& mesh, const SurfacePath& path, int rings);
+
 /// path: the initial contour (picks joined, open ones extended to the boundary).
 /// inside_left: closed contours' enclosed side (contour_orientation_left()); ignored for
 /// open contours, whose relief side is decided here (the side that rises).

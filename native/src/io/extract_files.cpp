@@ -47,7 +47,7 @@ ExtractionFiles write_extraction(const Mesh& mesh, const ExtractResult& result, 
     ply.triangles = result.relief_triangles;
     std::vector<float> height, u, v;
     for (std::size_t i = 0; i < result.relief_mesh_vertices.size(); ++i) {
-      ply.positions.push_back(mesh.position(result.relief_mesh_vertices[i]));
+      ply.positions.push_back(mesh.to_file(mesh.position(result.relief_mesh_vertices[i])));
       height.push_back(static_cast<float>(result.relief_heights[i]));
       u.push_back(static_cast<float>(result.relief_uv[i].x()));
       v.push_back(static_cast<float>(result.relief_uv[i].y()));
