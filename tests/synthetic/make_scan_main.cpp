@@ -128,7 +128,7 @@ int run_score(const std::string& truth_path, const std::string& result_path, con
       const double a = mesh.vertex_area(m);
       common += (in_truth[i] && in_result[i]) ? a : 0;
       uni += (in_truth[i] || in_result[i]) ? a : 0;
-      const bool grown = in_truth[i] || to_boundary.within(mesh.position(m), edge);
+      const bool grown = in_truth[i] || to_boundary.within(mesh.to_file(mesh.position(m)), edge);  // the truth is in the file's coordinates
       truth_n += in_truth[i], truth_a += in_truth[i] ? a : 0;
       grown_n += grown, grown_a += grown ? a : 0;
     }
