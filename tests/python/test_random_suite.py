@@ -52,8 +52,9 @@ def describe(row):
             f"{s.get('mean_from_truth', float('nan')):.2f} edges")
 
 
-# Issue 14 is not done: on this sample the engine is accurate on 17 of 20 (2 December 2026; every
-# wrong one flagged since the self-check finds contour that runs away from the step). The accuracy
+# Issue 14 is not done: on this sample the engine is accurate on 17 of 20 (2 December 2026, also after
+# the region-wide check and the repair; every wrong one flagged since the self-check finds contour that
+# runs away from the step). The accuracy
 # contract stays as written, marked as the known failure it is (strict: the day it passes, this mark
 # must go); test_no_worse_than_measured below guards against regressions.
 KNOWN_FAILURE = pytest.mark.xfail(strict=True, reason="issue 14 open: 17/20 accurate")
