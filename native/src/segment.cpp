@@ -352,7 +352,22 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       // The region-wide check only where the contour-wise one holds (a fill per attempt costs about
       // as much as a refinement on large regions), and for the repair of a region that took in
       // background; a failing attempt is doubtful already.
+      // A screen first: a robust quadric over the ring costs a pass over the ring, the fills a sparse
+      // solve each (as much as the snake on a large relief). Only a piece the screen sees is checked
+      // under the fills.
+      ContourEvidence screen = a.evidence;
       if (a.check.holds) {
+        BackgroundInsideOptions quadric;
+        quadric.model = BackgroundInsideModel::RingQuadric;
+        const BackgroundInside rough =
+            measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height, nullptr, quadric);
+        background_seconds += rough.seconds;
+        screen.background_measured = rough.measured && rough.deepest_vertex >= 0;
+        screen.background_depth = rough.depth / h_try;
+        screen.background_area = rough.area / (h_try * h_try);
+        screen.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
+      }
+      if (a.check.holds && (!screen.background_measured || background_taken_in(screen, self_check))) {
         if (!cache_->background) cache_->background = std::make_unique<BackgroundSolver>(mesh);
         BackgroundInside inside =
             measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height, cache_->background.get());
