@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "relief_snake/edge_distance.hpp"
+#include "relief_snake/mesh_graph.hpp"
 #include "relief_snake/height_statistics.hpp"
 
 namespace relief_snake {
@@ -15,7 +15,6 @@ BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<c
                                            const BackgroundSolver* solver, const BackgroundInsideOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
   BackgroundInside out;
-  out.step = step;
   const int n = mesh.n_vertices();
   if (static_cast<int>(region.size()) != n || !(h > 0) || !(step > 0)) return out;
   auto inside = [&](int v) { return region[v] != 0; };
@@ -27,7 +26,6 @@ BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<c
     const BackgroundResult fill = solver->solve(region, h);
     if (!fill.ok()) return out;
     for (const int v : fill.region_vertices) height[v] = fill.height[v];
-    out.ring_sigma = fill.ring_rms_residual;
   } else {
     std::vector<int> border_outside;  // outside vertices next to the region: the ring grows from them
     for (int v = 0; v < n; ++v) {
@@ -49,7 +47,6 @@ BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<c
     RobustFitOptions fit_options;
     fit_options.degree = 2;
     const RobustFit fit = fit_robust_background(mesh, ring_vertices, fit_options);
-    out.ring_sigma = fit.sigma;
     for (int v = 0; v < n; ++v)
       if (inside(v)) height[v] = fit.background.height(mesh.position(v));
   }
@@ -71,31 +68,21 @@ BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<c
   }
   const std::vector<double> depth = edge_distances(mesh, not_low_seeds, std::numeric_limits<double>::infinity(),
                                                    [&](int v) { return is_low[v] != 0; });
-  std::vector<int>& piece = out.piece;
-  piece.assign(n, -1);
-  std::vector<int> stack;
-  int pieces = 0;
-  for (int s = 0; s < n; ++s) {
-    if (!is_low[s] || piece[s] >= 0) continue;
+  out.piece.assign(n, -1);
+  for (const std::vector<int>& members : vertex_components(mesh, is_low)) {
+    const int label = static_cast<int>(out.piece_depth.size());
     double area = 0, deepest = 0;
-    int deepest_vertex = s;
+    int deepest_vertex = members.front();
     bool touches_outside = false;
-    stack.assign(1, s);
-    piece[s] = pieces;
-    while (!stack.empty()) {
-      const int v = stack.back();
-      stack.pop_back();
+    for (const int v : members) {
+      out.piece[v] = label;
       area += mesh.vertex_area(v);
       if (depth[v] > deepest) deepest = depth[v], deepest_vertex = v;
-      for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w) {
-        if (!inside(*w)) touches_outside = true;
-        if (is_low[*w] && piece[*w] < 0) piece[*w] = pieces, stack.push_back(*w);
-      }
+      for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w)
+        touches_outside = touches_outside || !inside(*w);
     }
-    ++pieces;
     out.piece_depth.push_back(touches_outside ? deepest : -1.0);
     if (!touches_outside) continue;  // a hollow inside the relief (a drop, a deep groove's middle)
-    out.low_area += area;
     if (deepest > out.depth) out.depth = deepest, out.area = area, out.deepest_vertex = deepest_vertex;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -107,6 +94,46 @@ std::vector<char> BackgroundInside::region_without(const std::vector<char>& regi
   if (piece.size() != region.size()) return out;
   for (std::size_t v = 0; v < region.size(); ++v)
     if (piece[v] >= 0 && piece_depth[piece[v]] > depth_limit) out[v] = 0;
+  return out;
+}
+
+bool deep_background_piece(double depth, double area, double limit) {
+  return depth > limit && area >= 0.5 * M_PI * limit * limit;
+}
+
+const BackgroundSolver& BackgroundInsideCheck::solver(std::unique_ptr<BackgroundSolver>& slot,
+                                                      const BackgroundOptions& options) {
+  if (!slot) slot = std::make_unique<BackgroundSolver>(mesh_, options);
+  return *slot;
+}
+
+BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region, double h, double step, double limit) {
+  auto deep = [&](const BackgroundInside& b) {
+    return b.measured && b.deepest_vertex >= 0 && deep_background_piece(b.depth, b.area, limit);
+  };
+  BackgroundInsideOptions quadric;
+  quadric.model = BackgroundInsideModel::RingQuadric;
+  const BackgroundInside screen = measure_background_inside(mesh_, region, h, step, nullptr, quadric);
+  double seconds = screen.seconds;
+  BackgroundInside out;
+  if (!screen.measured || deep(screen)) {
+    out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, {}));
+    seconds += out.seconds;
+    if (!out.measured) {  // cotangent weights of a sharp wall's projection can be singular
+      BackgroundOptions uniform;
+      uniform.laplacian = BackgroundLaplacian::Uniform;
+      out = measure_background_inside(mesh_, region, h, step, &solver(uniform_, uniform));
+      seconds += out.seconds;
+    }
+    if (deep(out)) {
+      BackgroundOptions positions;
+      positions.model = BackgroundModel::Surface;
+      const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(surface_, positions));
+      seconds += second.seconds;
+      if (second.measured && second.depth < out.depth) out.depth = second.depth, out.area = second.area;
+    }
+  }
+  out.seconds = seconds;
   return out;
 }
 

@@ -9,7 +9,7 @@
 #include <functional>
 #include <sstream>
 
-#include "relief_snake/edge_distance.hpp"
+#include "relief_snake/mesh_graph.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/height_statistics.hpp"
@@ -43,18 +43,8 @@ void validate(const DetectOptions& o) {
 
 /// Connected components (over mesh edges) of the flagged vertices.
 std::vector<std::vector<int>> components_of(const Mesh& mesh, const std::vector<char>& flag) {
-  std::vector<std::vector<int>> out;
-  std::vector<char> seen(mesh.n_vertices(), 0);
-  for (int s = 0; s < mesh.n_vertices(); ++s) {
-    if (!flag[s] || seen[s]) continue;
-    std::vector<int> comp = {s};
-    seen[s] = 1;
-    for (std::size_t head = 0; head < comp.size(); ++head)
-      for (const int* w = mesh.neighbors_begin(comp[head]); w != mesh.neighbors_end(comp[head]); ++w)
-        if (flag[*w] && !seen[*w]) seen[*w] = 1, comp.push_back(*w);
-    std::sort(comp.begin(), comp.end());
-    out.push_back(std::move(comp));
-  }
+  std::vector<std::vector<int>> out = vertex_components(mesh, flag);
+  for (std::vector<int>& comp : out) std::sort(comp.begin(), comp.end());
   return out;
 }
 

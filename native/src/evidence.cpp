@@ -1,5 +1,7 @@
 // Step evidence along a contour: local background planes outside, heights inside.
 #include "relief_snake/evidence.hpp"
+
+#include "relief_snake/background_inside.hpp"
 #include "relief_snake/plane_fit.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -259,9 +261,13 @@ Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region) {
   return area;
 }
 
+double background_depth_limit(const ContourEvidence& e, const SelfCheckOptions& options) {
+  return std::max(options.max_background_depth, e.background_depth_floor);
+}
+
 bool background_taken_in(const ContourEvidence& e, const SelfCheckOptions& options) {
-  const double limit = std::max(options.max_background_depth, e.background_depth_floor);
-  return e.background_measured && e.background_depth > limit && e.background_area >= 0.5 * M_PI * limit * limit;
+  return e.background_measured &&
+         deep_background_piece(e.background_depth, e.background_area, background_depth_limit(e, options));
 }
 
 SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options, const Vec3* far_position) {

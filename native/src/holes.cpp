@@ -4,9 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <queue>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -16,6 +14,7 @@
 #include "relief_snake/background.hpp"
 #include "relief_snake/error.hpp"
 #include "relief_snake/initial_contour.hpp"
+#include "relief_snake/mesh_graph.hpp"
 #include "relief_snake/region.hpp"
 #include "relief_snake/schedule.hpp"
 
@@ -28,48 +27,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Edge-length distances from the seeds over the vertices `allowed` admits, up to max_distance.
-std::vector<double> distances_from(const Mesh& mesh, const std::vector<int>& seeds,
-                                   const std::function<bool(int)>& allowed, double max_distance) {
-  std::vector<double> d(mesh.n_vertices(), kInf);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  for (const int s : seeds) {
-    d[s] = 0;
-    queue.push({0.0, s});
-  }
-  while (!queue.empty()) {
-    const auto [dv, v] = queue.top();
-    queue.pop();
-    if (dv > d[v]) continue;
-    for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v); ++w) {
-      if (!allowed(*w)) continue;
-      const double dw = dv + (mesh.position(*w) - mesh.position(v)).norm();
-      if (dw < d[*w] && dw <= max_distance) {
-        d[*w] = dw;
-        queue.push({dw, *w});
-      }
-    }
-  }
-  return d;
-}
-
-// Connected components (over mesh edges) of the flagged vertices.
-std::vector<std::vector<int>> components_of(const Mesh& mesh, const std::vector<char>& flags) {
-  std::vector<std::vector<int>> out;
-  std::vector<char> seen(mesh.n_vertices(), 0);
-  for (int v0 = 0; v0 < mesh.n_vertices(); ++v0) {
-    if (!flags[v0] || seen[v0]) continue;
-    std::vector<int> comp = {v0};
-    seen[v0] = 1;
-    for (std::size_t k = 0; k < comp.size(); ++k)
-      for (const int* w = mesh.neighbors_begin(comp[k]); w != mesh.neighbors_end(comp[k]); ++w)
-        if (flags[*w] && !seen[*w]) seen[*w] = 1, comp.push_back(*w);
-    out.push_back(std::move(comp));
-  }
-  return out;
-}
 
 // Region vertices with a neighbour outside the region: where the outer contour cut the mesh.
 std::vector<char> region_border(const Mesh& mesh, const std::vector<char>& region) {
@@ -145,7 +102,7 @@ std::vector<std::vector<int>> low_sets(const Mesh& mesh, const std::vector<char>
   std::vector<char> low(mesh.n_vertices(), 0);
   for (int v = 0; v < mesh.n_vertices(); ++v) low[v] = region[v] && height[v] < level;
   std::vector<std::vector<int>> out;
-  for (std::vector<int>& comp : components_of(mesh, low)) {
+  for (std::vector<int>& comp : vertex_components(mesh, low)) {
     bool touches = false;
     for (const int v : comp) touches = touches || border[v];
     if (!touches) out.push_back(std::move(comp));
@@ -172,11 +129,11 @@ std::vector<SurfacePoint> island_start(const Mesh& mesh, const std::vector<int>&
     for (const int* w = mesh.neighbors_begin(v); w != mesh.neighbors_end(v) && !e; ++w) e = !in[*w];
     if (e) edge.push_back(v);
   }
-  const std::vector<double> d = distances_from(mesh, edge, [&](int w) { return in[w] != 0; }, kInf);
+  const std::vector<double> d = edge_distances(mesh, edge, kInf, [&](int w) { return in[w] != 0; });
   for (const double erosion : {1.0, 0.5, 0.0}) {
     std::vector<char> kept(mesh.n_vertices(), 0);
     for (const int v : island) kept[v] = d[v] >= erosion * h;
-    std::vector<std::vector<int>> parts = components_of(mesh, kept);
+    std::vector<std::vector<int>> parts = vertex_components(mesh, kept);
     if (parts.empty()) continue;
     const auto largest = std::max_element(parts.begin(), parts.end(),
                                           [](const auto& a, const auto& b) { return a.size() < b.size(); });
@@ -364,7 +321,7 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
     for (int v = 0; v < mesh.n_vertices(); ++v)
       if (border[v]) seeds.push_back(v);
     const std::vector<double> ring_d =
-        distances_from(mesh, seeds, [&](int w) { return !region[w]; }, so.ring_width * h);
+        edge_distances(mesh, seeds, so.ring_width * h, [&](int w) { return !region[w]; });
     std::vector<int> ring;
     for (int v = 0; v < mesh.n_vertices(); ++v)
       if (!region[v] && ring_d[v] < kInf) ring.push_back(v);
@@ -402,7 +359,7 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
           std::vector<char> in(mesh.n_vertices(), 0);
           for (const int v : island) in[v] = 1;
           const std::vector<double> rim_d =
-              distances_from(mesh, island, [&](int w) { return region[w] != 0; }, so.rim_width * h);
+              edge_distances(mesh, island, so.rim_width * h, [&](int w) { return region[w] != 0; });
           std::vector<double> rim;
           for (int v = 0; v < mesh.n_vertices(); ++v)
             if (!in[v] && rim_d[v] < kInf) rim.push_back(height[v]);

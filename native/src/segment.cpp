@@ -118,10 +118,7 @@ struct Segmenter::Cache {
   std::unique_ptr<PlanarityField> planarity;
   PlanarityOptions options;  // what it was computed with
   std::shared_ptr<const MomentTree> tree;  // does not depend on h: kept across planarity fields
-  // The thin-plate fill's Laplacian (background_inside.hpp): cotangent weights, and uniform ones
-  // where those are singular.
-  std::unique_ptr<BackgroundSolver> background, background_uniform;
-  std::unique_ptr<BackgroundSolver> background_surface;  // the second opinion: a fill of the positions
+  std::unique_ptr<BackgroundInsideCheck> background_inside;  // the fills for the region-wide check
 };
 
 Segmenter::Segmenter(const Mesh& mesh) : mesh_(mesh), cache_(std::make_unique<Cache>()) {}
@@ -349,59 +346,17 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       const int far_index = a.evidence.step.far_point;
       const Vec3 far_position = far_index >= 0 ? mesh.to_file(position(mesh, a.run.contour[far_index])) : Vec3::Zero();
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
-      // The region-wide check only where the contour-wise one holds (a fill per attempt costs about
-      // as much as a refinement on large regions), and for the repair of a region that took in
-      // background; a failing attempt is doubtful already.
-      // A screen first: a robust quadric over the ring costs a pass over the ring, the fills a sparse
-      // solve each (as much as the snake on a large relief). Only a piece the screen sees is checked
-      // under the fills.
-      ContourEvidence screen = a.evidence;
+      // The region-wide check only where the contour-wise one holds (a failing attempt is doubtful
+      // already), and for the repair of a region that took in background.
       if (a.check.holds) {
-        BackgroundInsideOptions quadric;
-        quadric.model = BackgroundInsideModel::RingQuadric;
-        const BackgroundInside rough =
-            measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height, nullptr, quadric);
-        background_seconds += rough.seconds;
-        screen.background_measured = rough.measured && rough.deepest_vertex >= 0;
-        screen.background_depth = rough.depth / h_try;
-        screen.background_area = rough.area / (h_try * h_try);
-        screen.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
-      }
-      if (a.check.holds && (!screen.background_measured || background_taken_in(screen, self_check))) {
-        if (!cache_->background) cache_->background = std::make_unique<BackgroundSolver>(mesh);
-        BackgroundInside inside =
-            measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height, cache_->background.get());
+        if (!cache_->background_inside) cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh);
+        a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
+        BackgroundInside inside = cache_->background_inside->measure(
+            a.region, h_try, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * h_try);
         background_seconds += inside.seconds;
-        if (!inside.measured) {  // cotangent weights of a sharp wall's projection can be singular
-          if (!cache_->background_uniform) {
-            BackgroundOptions uniform;
-            uniform.laplacian = BackgroundLaplacian::Uniform;
-            cache_->background_uniform = std::make_unique<BackgroundSolver>(mesh, uniform);
-          }
-          inside = measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height,
-                                             cache_->background_uniform.get());
-          background_seconds += inside.seconds;
-        }
         a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;
         a.evidence.background_depth = inside.depth / h_try;
         a.evidence.background_area = inside.area / (h_try * h_try);
-        a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
-        // A piece must also show under the fill of the positions themselves: the height field misses
-        // the shape of a large relief's background on a vase, where the relief then seems to sag.
-        if (background_taken_in(a.evidence, self_check)) {
-          if (!cache_->background_surface) {
-            BackgroundOptions surface;
-            surface.model = BackgroundModel::Surface;
-            cache_->background_surface = std::make_unique<BackgroundSolver>(mesh, surface);
-          }
-          const BackgroundInside second = measure_background_inside(mesh, a.region, h_try, a.evidence.step.step_height,
-                                                                    cache_->background_surface.get());
-          background_seconds += second.seconds;
-          if (second.measured && second.depth < inside.depth) {
-            a.evidence.background_depth = second.depth / h_try;
-            a.evidence.background_area = second.area / (h_try * h_try);
-          }
-        }
         if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.to_file(mesh.position(inside.deepest_vertex));
         if (inside_out) *inside_out = std::move(inside);
         a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
@@ -412,7 +367,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     // from the rest's outline at the finest spacing, where narrow concavities hold it.
     auto repaired = [&](const Attempt& a, const BackgroundInside& inside, double w) {
       Attempt r;
-      const double limit = std::max(self_check.max_background_depth, a.evidence.background_depth_floor) * h_try;
+      const double limit = background_depth_limit(a.evidence, self_check) * h_try;
       std::vector<int> loop = region_outer_loop(mesh, inside.region_without(a.region, limit));
       if (loop.size() < 8) return r;
       if (!inside_left) std::reverse(loop.begin(), loop.end());

@@ -14,6 +14,7 @@
 //    from one of its vertices to the nearest vertex that is not in it (relief, or outside).
 //    A blended step's foot, a groove or the gap between the contour and the foot is a thin strip;
 //    a bridged concavity or a lobe holds a disk of background.
+#include <memory>
 #include <vector>
 
 #include "relief_snake/background.hpp"
@@ -32,14 +33,11 @@ struct BackgroundInsideOptions {
 
 struct BackgroundInside {
   bool measured = false;       ///< false: no ring (the region covers its component) or too few vertices
-  double ring_sigma = 0;       ///< the ring's heights above the fit: robust noise (quadric), RMS residual (thin plate)
   double seconds = 0;          ///< time taken
-  double step = 0;             ///< the step the low share was taken of
   /// The largest low piece touching the outside, by depth: its depth (inradius) and area, and a
   /// vertex at its deepest point (-1: none).
   double depth = 0, area = 0;
   int deepest_vertex = -1;
-  double low_area = 0;         ///< total area of all low pieces touching the outside
   /// #V: the low piece each region vertex belongs to (-1: none), and per piece its depth, or -1
   /// for a piece that does not touch the outside (a hollow inside the relief).
   std::vector<int> piece;
@@ -54,5 +52,28 @@ struct BackgroundInside {
 BackgroundInside measure_background_inside(const Mesh& mesh, const std::vector<char>& region, double h, double step,
                                            const BackgroundSolver* solver,
                                            const BackgroundInsideOptions& options = {});
+
+/// A piece deep enough to be background taken in: deeper than `limit` and holding at least half the
+/// area of a disk that deep (edge distances overstate a small piece's depth on a coarse mesh). In any
+/// consistent units: mesh units and squared mesh units, or h and h^2.
+bool deep_background_piece(double depth, double area, double limit);
+
+/// The check as the segmenter runs it, owning the fills' precomputation for one mesh. A robust ring
+/// quadric screens (a pass over the ring; each fill is a sparse solve, as much as the snake on a large
+/// relief); only if it sees a piece deeper than `limit` (mesh units), or cannot measure, is the region
+/// measured under the height-field fill (cotangent weights, uniform ones where those are singular). A
+/// piece deep there must also show under the fill of the positions (BackgroundModel::Surface, which
+/// follows a vase the height field misses): the shallower depth and its area are kept, with the height
+/// field's pieces and deepest vertex. measured is false when the screen saw nothing deep.
+class BackgroundInsideCheck {
+ public:
+  explicit BackgroundInsideCheck(const Mesh& mesh) : mesh_(mesh) {}
+  BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit);
+
+ private:
+  const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
+  const Mesh& mesh_;
+  std::unique_ptr<BackgroundSolver> cotangent_, uniform_, surface_;
+};
 
 }  // namespace relief_snake

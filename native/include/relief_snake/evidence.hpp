@@ -123,9 +123,11 @@ struct SelfCheck {
   std::vector<std::string> reasons;  ///< one plain sentence per failed check
 };
 
-/// The region took in background (ContourEvidence::background_*): a measured piece deeper than
-/// max(max_background_depth, the edge floor) and holding at least half the area of a disk that deep
-/// (the edge-distance depth of a small piece on a coarse mesh overstates it).
+/// The depth (in h) a piece of background inside the region must exceed: max(max_background_depth,
+/// the edge floor).
+double background_depth_limit(const ContourEvidence& evidence, const SelfCheckOptions& options = {});
+/// The region took in background (ContourEvidence::background_*): a measured piece that is
+/// deep_background_piece() (background_inside.hpp) against background_depth_limit().
 bool background_taken_in(const ContourEvidence& evidence, const SelfCheckOptions& options = {});
 
 /// Judges a contour's evidence; h: the step height used. far_position: where the longest

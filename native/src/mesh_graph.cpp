@@ -1,5 +1,5 @@
-// Dijkstra along mesh edges from several seeds.
-#include "relief_snake/edge_distance.hpp"
+// Distances and components over the mesh's edge graph (mesh_graph.hpp).
+#include "relief_snake/mesh_graph.hpp"
 
 #include <limits>
 #include <queue>
@@ -24,6 +24,21 @@ std::vector<double> edge_distances(const Mesh& mesh, const std::vector<int>& see
     }
   }
   return dist;
+}
+
+std::vector<std::vector<int>> vertex_components(const Mesh& mesh, const std::vector<char>& flags) {
+  std::vector<std::vector<int>> out;
+  std::vector<char> seen(mesh.n_vertices(), 0);
+  for (int s = 0; s < mesh.n_vertices(); ++s) {
+    if (!flags[s] || seen[s]) continue;
+    std::vector<int> comp = {s};
+    seen[s] = 1;
+    for (std::size_t head = 0; head < comp.size(); ++head)
+      for (const int* w = mesh.neighbors_begin(comp[head]); w != mesh.neighbors_end(comp[head]); ++w)
+        if (flags[*w] && !seen[*w]) seen[*w] = 1, comp.push_back(*w);
+    out.push_back(std::move(comp));
+  }
+  return out;
 }
 
 }  // namespace relief_snake
