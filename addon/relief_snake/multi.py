@@ -20,7 +20,7 @@ time, Segment's included.
 
 import bpy
 
-from . import api, job, mesh_io, pick_order, preview, properties, summary
+from . import api, job, mesh_io, modal_run, pick_order, preview, properties, summary
 from .job import MESH_CACHE, EngineError, fingerprint
 
 __all__ = ["groups_from_vertex_groups", "segment_vertex_groups", "detect_object", "apply_candidates",
@@ -222,76 +222,25 @@ def busy():
     return _ModalRun.running or operators.MESH_OT_relief_snake_segment._modal
 
 
-class _ModalRun:
-    """The interactive run of Detect and Segment Pick Groups, like Segment's (operators.py): the
-    first timer tick reads the mesh (after the status bar said so), a job.MeshJob runs the engine,
-    later ticks show its progress, Esc cancels at once, and every step runs under try/finally so
-    that the timer, the preview and the status text go away however the run ends. Subclasses
-    give _read(context) -> (obj, vertices, triangles, work(mesh, progress), progress-bar total or
-    0), _status_text(snap) and _finish(context, obj, doc)."""
+class _ModalRun(modal_run.ModalRun):
+    """The interactive run of Detect and Segment Pick Groups (modal_run.py): a job.MeshJob runs the
+    engine. Subclasses give _read(context) -> (obj, vertices, triangles, work(mesh, progress),
+    progress-bar total or 0), _status_text(snap) and _finish(context, obj, doc)."""
 
     running = None  # the operator whose run is going (shared by both operators: one at a time)
     _total = 0  # what the progress bar counts to (0: no bar)
 
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        return self._invoke_modal(context)
+    def _set_current_run(self, op):
+        _ModalRun.running = op
+
+    def _current_run(self):
+        return _ModalRun.running
 
     def _invoke_modal(self, context):
         if busy() is not None:
             self.report({'ERROR'}, "Relief Snake is already running: wait for it or press Esc")
             return {'CANCELLED'}
-        self._job = None
-        self._obj_name = None
-        self._shown_serial = -1
-        self._progress_on = False
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(0.05, window=context.window)
-        wm.modal_handler_add(self)
-        _ModalRun.running = self
-        self._status(context, "Relief Snake: reading mesh... (Esc cancels)")
-        return {'RUNNING_MODAL'}
-
-    def _status(self, context, text):
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
-
-    def _cleanup(self, context):
-        wm = context.window_manager
-        if getattr(self, "_timer", None) is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        if getattr(self, "_progress_on", False):
-            wm.progress_end()
-            self._progress_on = False
-        preview.stop()
-        self._status(context, None)
-        if _ModalRun.running is self:
-            _ModalRun.running = None
-        _redraw_views(context)
-
-    def modal(self, context, event):
-        running = False
-        try:
-            ret = self._modal_step(context, event)
-            running = 'RUNNING_MODAL' in ret or 'PASS_THROUGH' in ret
-            return ret
-        except Exception as exc:  # never leave a timer, a preview or "already running" behind
-            if self._job is not None:
-                self._job.cancel()
-            self.report({'ERROR'}, "Relief Snake failed: %s: %s" % (type(exc).__name__, exc))
-            return {'CANCELLED'}
-        finally:
-            if not running:
-                self._cleanup(context)
-
-    def cancel(self, context):
-        # Blender ends the modal operator (a file is loaded, the window closes): the worker is
-        # asked to stop and winds down in the background; its result is dropped.
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-        self._cleanup(context)
+        return self._begin_modal(context)
 
     def _start(self, context):
         obj, vertices, triangles, work, total = self._read(context)
@@ -330,7 +279,7 @@ class _ModalRun:
             if self._progress_on:
                 context.window_manager.progress_update(min(snap.index, self._total))
             self._status(context, "Relief Snake: %s (Esc cancels)" % self._status_text(snap))
-            _redraw_views(context)
+            modal_run.redraw_views(context)
             return {'RUNNING_MODAL'}
         if run.cancelled:
             self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
@@ -451,15 +400,6 @@ class MESH_OT_relief_snake_detect(_ModalRun, bpy.types.Operator):
     def _finish(self, context, obj, doc):
         DETECTIONS[obj.name_full] = doc
         return self._report_done(context, doc)
-
-
-def _redraw_views(context):
-    screen = context.screen
-    if screen is None:
-        return
-    for area in screen.areas:
-        if area.type == 'VIEW_3D':
-            area.tag_redraw()
 
 
 class MESH_OT_relief_snake_apply_candidates(bpy.types.Operator):

@@ -12,7 +12,7 @@ the timer, the draw handler and the status text go away when the run ends.
 
 import bpy
 
-from . import api, job, pick_order, preview, properties, region_view, summary, units
+from . import api, job, modal_run, pick_order, preview, properties, region_view, summary, units
 
 PHASES = ("intake", "segment", "coarse", "refine", "stabilise")
 
@@ -27,7 +27,7 @@ def _threads_option(context):
     return {"threads": int(threads)} if threads else {}
 
 
-class MESH_OT_relief_snake_segment(bpy.types.Operator):
+class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
     """Outline the relief around the selected vertices (picked in order) and put its vertices in a group"""
     bl_idname = "mesh.relief_snake_segment"
     bl_label = "Segment Relief"
@@ -107,11 +107,12 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
 
-    # -- interactive ------------------------------------------------------------------
-    def invoke(self, context, event):
-        if bpy.app.background or context.window is None:
-            return self.execute(context)
-        return self._invoke_modal(context)
+    # -- interactive (modal_run.py) ---------------------------------------------------------
+    def _set_current_run(self, op):
+        MESH_OT_relief_snake_segment._modal = op
+
+    def _current_run(self):
+        return MESH_OT_relief_snake_segment._modal
 
     def _invoke_modal(self, context):
         from . import multi  # Detect and Segment Pick Groups run the same way: one run at a time
@@ -119,49 +120,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             self.report({'ERROR'}, "Relief Snake is already running: wait for it or press Esc")
             return {'CANCELLED'}
         self._fill_from_scene(context)
-        self._job = None
-        self._obj_name = None
-        self._shown_serial = -1
-        wm = context.window_manager
-        # The read happens on the first timer tick, after the status bar has been drawn.
-        self._timer = wm.event_timer_add(0.05, window=context.window)
-        wm.modal_handler_add(self)
-        MESH_OT_relief_snake_segment._modal = self
-        self._status(context, "Relief Snake: reading mesh... (Esc cancels)")
-        return {'RUNNING_MODAL'}
-
-    def _status(self, context, text):
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
-
-    def _cleanup(self, context):
-        wm = context.window_manager
-        if getattr(self, "_timer", None) is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        if getattr(self, "_progress_on", False):
-            wm.progress_end()
-            self._progress_on = False
-        preview.stop()
-        self._status(context, None)
-        if MESH_OT_relief_snake_segment._modal is self:
-            MESH_OT_relief_snake_segment._modal = None
-        _redraw_views(context)
-
-    def modal(self, context, event):
-        running = False
-        try:
-            ret = self._modal_step(context, event)
-            running = 'RUNNING_MODAL' in ret or 'PASS_THROUGH' in ret
-            return ret
-        except Exception as exc:  # never leave a timer, a draw handler or "already running" behind
-            if self._job is not None:
-                self._job.cancel()
-            self.report({'ERROR'}, "Relief Snake failed: %s: %s" % (type(exc).__name__, exc))
-            return {'CANCELLED'}
-        finally:
-            if not running:
-                self._cleanup(context)
+        return self._begin_modal(context)
 
     def _start(self, context):
         obj, request, info = self._prepare(context)
@@ -204,7 +163,7 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
             else:
                 text = "Relief Snake: %s, step %d, %d points (Esc cancels)" % (words, snap.iteration, snap.points)
             self._status(context, text)
-            _redraw_views(context)
+            modal_run.redraw_views(context)
             return {'RUNNING_MODAL'}
         if run.cancelled:
             self.report({'WARNING'}, "Relief Snake cancelled: nothing was changed")
@@ -224,13 +183,6 @@ class MESH_OT_relief_snake_segment(bpy.types.Operator):
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
-
-    def cancel(self, context):
-        # Blender ends the modal operator (a file is loaded, the window closes): ask the worker
-        # to stop and return at once; it winds down in the background and its result is dropped.
-        if getattr(self, "_job", None) is not None:
-            self._job.cancel()
-        self._cleanup(context)
 
 
 class MESH_OT_relief_snake_measure(bpy.types.Operator):
@@ -266,15 +218,6 @@ class MESH_OT_relief_snake_measure(bpy.types.Operator):
         settings.estimate_step_height = False
         self.report({'INFO'}, "Relief Snake: step height set to %s" % units.format_length(context.scene, h))
         return {'FINISHED'}
-
-
-def _redraw_views(context):
-    screen = context.screen
-    if screen is None:
-        return
-    for area in screen.areas:
-        if area.type == 'VIEW_3D':
-            area.tag_redraw()
 
 
 classes = (MESH_OT_relief_snake_segment, MESH_OT_relief_snake_measure)

@@ -985,7 +985,8 @@ class ModalPath(AddonTestCase):
             def report(self, kind, text):
                 reports.append((set(kind), text))
 
-        for name in ("modal", "_modal_step", "_start", "_prepare", "_finish", "_cleanup", "_status"):
+        for name in ("modal", "_modal_step", "_start", "_prepare", "_finish", "_cleanup", "_status", "_current_run",
+                     "_set_current_run"):
             setattr(Stand_in, name, getattr(cls, name))
         op = Stand_in()
         s = bpy.context.scene.relief_snake
@@ -1173,8 +1174,8 @@ class SeveralReliefsModal(AddonTestCase):
     engine in a worker -> the result written on the main thread; Esc cancels and changes nothing.
     Driven headless through the operators' own methods on a stand-in (as ModalPath does)."""
 
-    METHODS = ("_invoke_modal", "modal", "_modal_step", "_start", "_cleanup", "_status", "cancel", "_read",
-               "_status_text", "_finish", "_report_done")
+    METHODS = ("_invoke_modal", "_begin_modal", "_current_run", "_set_current_run", "modal", "_modal_step", "_start",
+               "_cleanup", "_status", "cancel", "_read", "_status_text", "_finish", "_report_done")
 
     def setUp(self):
         super().setUp()
