@@ -133,6 +133,7 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
       if (second.measured && second.depth < out.depth) out.depth = second.depth, out.area = second.area;
     }
   }
+  out.checked = screen.measured || out.measured;
   out.seconds = seconds;
   return out;
 }

@@ -281,7 +281,7 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("only " + percent(evidence.step_share) +
                             " of the contour runs along a step: it may have crossed into the relief or stopped "
                             "on detail or texture");
-  if (evidence.longest_far > options.max_far_run * h) {
+  if (!all.region_checked && evidence.longest_far > options.max_far_run * h) {
     std::string where;
     if (far_position)
       where = " around (" + number((*far_position)[0]) + ", " + number((*far_position)[1]) + ", " +

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <unordered_set>
 
@@ -260,6 +261,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   // its h is on something else (texture, detail).
   SelfCheckOptions self_check;
   if (options.refit_step_height) self_check.max_step_ratio = std::max(1.5, options.refit_ratio * 1.15);
+  // The contour-wise verdict without the far run, which the region-wide check replaces where it runs.
+  SelfCheckOptions contour_wise = self_check;
+  contour_wise.max_far_run = std::numeric_limits<double>::infinity();
   EvidenceOptions evidence_options;
   evidence_options.closed = options.closed;
 
@@ -348,12 +352,13 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       // The region-wide check only where the contour-wise one holds (a failing attempt is doubtful
       // already), and for the repair of a region that took in background.
-      if (a.check.holds) {
+      if (judge(a.evidence, h_try, contour_wise).holds) {
         if (!cache_->background_inside) cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh);
         a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
         BackgroundInside inside = cache_->background_inside->measure(
             a.region, h_try, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * h_try);
         background_seconds += inside.seconds;
+        a.evidence.region_checked = inside.checked;
         a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;
         a.evidence.background_depth = inside.depth / h_try;
         a.evidence.background_area = inside.area / (h_try * h_try);

@@ -120,3 +120,23 @@ TEST(BackgroundInside, NothingToMeasureWithoutARingOrAStep) {
   EXPECT_FALSE(measure_background_inside(mesh, disk_region(scan, mesh, 0), scan.h, scan.h, nullptr).measured);
   EXPECT_FALSE(measure_background_inside(mesh, std::vector<char>(3, 1), scan.h, scan.h, &solver).measured);
 }
+
+TEST(BackgroundInside, TheCheckSaysWhetherItCouldLook) {
+  // The segmenter's check: on the true relief its screen sees nothing deep, so no piece is
+  // reported (measured stays false), but the region was checked, and the self-check relies on it
+  // instead of the contour's far run. With no ring round the region it could not look at all.
+  const syn::Scan scan = disk_scan(syn::Background::Sphere, syn::Step::Blended);
+  const Mesh mesh = syn::to_mesh(scan);
+  BackgroundInsideCheck check(mesh);
+  const double limit = depth_limit(mesh, scan.h);
+  const BackgroundInside right = check.measure(disk_region(scan, mesh, 0), scan.h, scan.h, limit);
+  EXPECT_TRUE(right.checked);
+  EXPECT_FALSE(right.measured && deep_background_piece(right.depth, right.area, limit));
+  const BackgroundInside lobe = check.measure(disk_region(scan, mesh, 2.5 * scan.h), scan.h, scan.h, limit);
+  EXPECT_TRUE(lobe.checked);
+  ASSERT_TRUE(lobe.measured);
+  EXPECT_TRUE(deep_background_piece(lobe.depth, lobe.area, limit));
+  const BackgroundInside none = check.measure(std::vector<char>(mesh.n_vertices(), 1), scan.h, scan.h, limit);
+  EXPECT_FALSE(none.checked);
+  EXPECT_FALSE(none.measured);
+}

@@ -155,6 +155,11 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   c = judge(e, 1.0, {}, &where);
   ASSERT_EQ(c.reasons.size(), 1u);
   EXPECT_NE(c.reasons.front().find("(1, 2, 3)"), std::string::npos);
+  // Where the region-wide check could look at the region, it, not the far run, decides on
+  // background taken in.
+  e.region_checked = true;
+  EXPECT_TRUE(judge(e, 1.0, {}, &where).holds);
+  e.region_checked = false;
   e.step.longest_far = 0;
   // Background inside the region: judged only when measured, above the depth and the edge floor.
   e.background_depth = 2.0;

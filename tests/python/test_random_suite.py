@@ -53,8 +53,7 @@ def describe(row):
 
 
 # Issue 14 is not done: on this sample the engine is accurate on 17 of 20 (2 December 2026, also after
-# the region-wide check and the repair; every wrong one flagged since the self-check finds contour that
-# runs away from the step). The accuracy
+# the region-wide check and the repair; every wrong one flagged). The accuracy
 # contract stays as written, marked as the known failure it is (strict: the day it passes, this mark
 # must go); test_no_worse_than_measured below guards against regressions.
 KNOWN_FAILURE = pytest.mark.xfail(strict=True, reason="issue 14 open: 17/20 accurate")

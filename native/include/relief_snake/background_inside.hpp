@@ -33,6 +33,9 @@ struct BackgroundInsideOptions {
 
 struct BackgroundInside {
   bool measured = false;       ///< false: no ring (the region covers its component) or too few vertices
+  /// BackgroundInsideCheck: the region could be checked (its screen or a fill measured it), even if
+  /// nothing deep was seen and `measured` stays false.
+  bool checked = false;
   double seconds = 0;          ///< time taken
   /// The largest low piece touching the outside, by depth: its depth (inradius) and area, and a
   /// vertex at its deepest point (-1: none).
@@ -64,7 +67,8 @@ bool deep_background_piece(double depth, double area, double limit);
 /// measured under the height-field fill (cotangent weights, uniform ones where those are singular). A
 /// piece deep there must also show under the fill of the positions (BackgroundModel::Surface, which
 /// follows a vase the height field misses): the shallower depth and its area are kept, with the height
-/// field's pieces and deepest vertex. measured is false when the screen saw nothing deep.
+/// field's pieces and deepest vertex. measured is false when the screen saw nothing deep; checked is
+/// true whenever the screen or a fill could measure the region.
 class BackgroundInsideCheck {
  public:
   explicit BackgroundInsideCheck(const Mesh& mesh) : mesh_(mesh) {}

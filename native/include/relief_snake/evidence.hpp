@@ -94,7 +94,10 @@ struct SelfCheckOptions {
   /// outside [1 / max_area_ratio, max_area_ratio] the region leaked or lost a piece.
   double max_area_ratio = 1.25;
   /// Longest stretch of contour (in h) allowed to run away from the step (StepEvidence::longest_far):
-  /// a lobe out into the background, or a bridge across a concavity.
+  /// a lobe out into the background, or a bridge across a concavity. A reason only where the
+  /// region-wide check could not run (ContourEvidence::region_checked): where it can, it decides on
+  /// background taken in (on the randomized suite the far run flagged right results on textured,
+  /// coarse or rimmed reliefs, and no wrong one the region-wide check missed).
   double max_far_run = 1.5;
   /// Deepest piece of background allowed inside the region (BackgroundInside::depth, in h; and
   /// at least ContourEvidence::background_depth_floor): a bridged concavity or a lobe holds a
@@ -111,6 +114,7 @@ struct ContourEvidence {
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
   /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
   /// depth and area, and the floor under the depth threshold (two average edges, in h).
+  bool region_checked = false;  ///< the region-wide check ran and could measure the region
   bool background_measured = false;
   double background_depth = 0, background_area = 0, background_depth_floor = 0;
   Vec3 background_where = Vec3::Zero();  ///< the deepest point of that piece (the file's coordinates)
