@@ -354,42 +354,93 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
     return mesh.position(v);
   };
 
-  using SparseMatrix = Eigen::SparseMatrix<double>;
-  using Triplet = Eigen::Triplet<double>;
-  std::vector<Triplet> wu, wf;
-  wu.reserve(rows.size() * 7);
-  wf.reserve(rows.size() * 4);
-  Eigen::VectorXd inverse_area(static_cast<Eigen::Index>(rows.size()));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const int v = rows[i];
-    const int row = static_cast<int>(i);
-    double diagonal = 0;
-    for (std::size_t k = ring_offset_[v]; k < ring_offset_[v + 1]; ++k) {
-      const int w = mesh.neighbors_begin(v)[k - ring_offset_[v]];
-      const double weight = weights[k];
-      diagonal -= weight;
-      if (unknown_id[w] >= 0)
-        wu.emplace_back(row, unknown_id[w], weight);
-      else
-        wf.emplace_back(row, fixed_id[w], weight);
-    }
-    if (unknown_id[v] >= 0)
-      wu.emplace_back(row, unknown_id[v], diagonal);
-    else
-      wf.emplace_back(row, fixed_id[v], diagonal);
-    inverse_area[row] = area[v] > 0 ? 1.0 / area[v] : 0.0;
-  }
+  // --- the normal equations Q X = rhs of the thin-plate energy sum_rows |W X + W_fixed X_fixed|^2 / A:
+  // Q = WU^T diag(1/A) WU and rhs = -WU^T diag(1/A) (WF XF), WU and WF being the rows' Laplacian
+  // weights on the unknowns and on the fixed vertices. Assembled from the rows directly (each row
+  // holds a one-ring, so column u of Q gathers the rows through u) instead of through sparse
+  // products of the weight matrices; the sums run in the same order as Eigen's products did
+  // (rows ascending, fixed vertices ascending), so Q and rhs are the same numbers.
   const Eigen::Index nr = static_cast<Eigen::Index>(rows.size()), nu = static_cast<Eigen::Index>(unknowns.size()),
                      nf = static_cast<Eigen::Index>(fixed.size());
-  SparseMatrix WU(nr, nu), WF(nr, nf);
-  WU.setFromTriplets(wu.begin(), wu.end());
-  WF.setFromTriplets(wf.begin(), wf.end());
   Eigen::MatrixXd XF(nf, dims);
   for (Eigen::Index j = 0; j < nf; ++j) XF.row(j) = value(fixed[j]).head(dims).transpose();
-
-  const SparseMatrix DWU = inverse_area.asDiagonal() * WU;
-  SparseMatrix Q = SparseMatrix(WU.transpose()) * DWU;
-  Eigen::MatrixXd rhs = -(DWU.transpose() * (WF * XF));
+  // Row r's entries on the unknowns (row_start[r] to row_start[r + 1]) and WF XF's row r.
+  std::vector<int> row_start(rows.size() + 1, 0), entry_unknown;
+  std::vector<double> entry_weight, inverse_area(rows.size());
+  entry_unknown.reserve(rows.size() * 8);
+  entry_weight.reserve(rows.size() * 8);
+  Eigen::MatrixXd fixed_part = Eigen::MatrixXd::Zero(nr, dims);
+  std::vector<std::pair<int, double>> fixed_entries;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const int v = rows[i];
+    fixed_entries.clear();
+    double diagonal = 0;
+    auto add = [&](int w, double weight) {
+      if (unknown_id[w] >= 0) {
+        entry_unknown.push_back(unknown_id[w]);
+        entry_weight.push_back(weight);
+      } else {
+        fixed_entries.emplace_back(fixed_id[w], weight);
+      }
+    };
+    for (std::size_t k = ring_offset_[v]; k < ring_offset_[v + 1]; ++k) {
+      diagonal -= weights[k];
+      add(mesh.neighbors_begin(v)[k - ring_offset_[v]], weights[k]);
+    }
+    add(v, diagonal);
+    row_start[i + 1] = static_cast<int>(entry_unknown.size());
+    std::sort(fixed_entries.begin(), fixed_entries.end());
+    for (const auto& [j, weight] : fixed_entries) fixed_part.row(static_cast<Eigen::Index>(i)) += weight * XF.row(j);
+    inverse_area[i] = area[v] > 0 ? 1.0 / area[v] : 0.0;
+  }
+  // The rows through each unknown, ascending (WU's columns).
+  std::vector<int> column_start(static_cast<std::size_t>(nu) + 1, 0);
+  for (const int u : entry_unknown) ++column_start[static_cast<std::size_t>(u) + 1];
+  for (Eigen::Index u = 0; u < nu; ++u) column_start[u + 1] += column_start[u];
+  std::vector<int> column_row(entry_unknown.size()), fill(column_start.begin(), column_start.end() - 1);
+  std::vector<double> column_weight(entry_unknown.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (int e = row_start[i]; e < row_start[i + 1]; ++e) {
+      const int at = fill[entry_unknown[e]]++;
+      column_row[at] = static_cast<int>(i);
+      column_weight[at] = entry_weight[e];
+    }
+  using SparseMatrix = Eigen::SparseMatrix<double>;
+  SparseMatrix Q(nu, nu);
+  Q.reserve(static_cast<Eigen::Index>(entry_unknown.size()) * 4);
+  Eigen::MatrixXd rhs(nu, dims);
+  {
+    std::vector<char> seen(static_cast<std::size_t>(nu), 0);
+    std::vector<double> sum(static_cast<std::size_t>(nu), 0.0);
+    std::vector<int> pattern;
+    for (Eigen::Index u = 0; u < nu; ++u) {
+      pattern.clear();
+      Eigen::RowVectorXd right = Eigen::RowVectorXd::Zero(dims);
+      for (int c = column_start[u]; c < column_start[u + 1]; ++c) {
+        const int row = column_row[c];
+        const double x = inverse_area[row] * column_weight[c];  // (diag(1/A) WU)(row, u)
+        right += x * fixed_part.row(row);
+        for (int e = row_start[row]; e < row_start[row + 1]; ++e) {
+          const int i = entry_unknown[e];
+          if (!seen[i]) {
+            seen[i] = 1;
+            sum[i] = entry_weight[e] * x;
+            pattern.push_back(i);
+          } else {
+            sum[i] += entry_weight[e] * x;
+          }
+        }
+      }
+      rhs.row(u) = -right;
+      std::sort(pattern.begin(), pattern.end());
+      Q.startVec(u);
+      for (const int i : pattern) {
+        Q.insertBack(i, u) = sum[i];
+        seen[i] = 0;
+      }
+    }
+    Q.finalize();
+  }
   if (soft) {
     const double s = options_.smoothing * h;
     const double stiffness = 1.0 / (s * s * s * s);

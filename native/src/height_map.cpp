@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <limits>
 #include <numeric>
@@ -154,7 +155,9 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
   std::vector<char> pinned(static_cast<std::size_t>(n), 0);
   for (int i = 0; i < n; ++i)
     if (find(i) == i) pinned[lo[i]] = pinned[hi[i]] = 1;
-  // Unknowns: u then v of each free vertex.
+  // Unknowns: z = u + i v of each free vertex. Per triangle the energy is |sum_j W_j z_j|^2 with
+  // complex W_j (the real form's two rows, re and im, are one complex row), so the normal
+  // equations are Hermitian with n unknowns instead of 2n real ones, for the same minimiser.
   std::vector<int> id(static_cast<std::size_t>(n), -1);
   int nfree = 0;
   for (int i = 0; i < n; ++i)
@@ -163,10 +166,11 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
     *uv = plane;
     return true;
   }
-  using Triplet = Eigen::Triplet<double>;
+  using Complex = std::complex<double>;
+  using Triplet = Eigen::Triplet<Complex>;
   std::vector<Triplet> entries;
-  entries.reserve(nt * 12);
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(2 * static_cast<Eigen::Index>(nt));
+  entries.reserve(nt * 3);
+  Eigen::VectorXcd rhs = Eigen::VectorXcd::Zero(static_cast<Eigen::Index>(nt));
   double area3 = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     const int c[3] = {patch.triangles[3 * t], patch.triangles[3 * t + 1], patch.triangles[3 * t + 2]};
@@ -178,39 +182,33 @@ bool conformal_uv(const HeightPatch& patch, const std::vector<Vec2>& plane, std:
     const Vec3 x = e1.normalized(), y = normal.normalized().cross(x);
     const Vec2 p[3] = {Vec2(0, 0), Vec2(e1.norm(), 0), Vec2(e2.dot(x), e2.dot(y))};
     const double w = 1.0 / std::sqrt(twice_area);
-    const int re = static_cast<int>(2 * t), im = re + 1;
+    const int row = static_cast<int>(t);
     for (int j = 0; j < 3; ++j) {
-      const Vec2 W = p[(j + 2) % 3] - p[(j + 1) % 3];  // sum_j W_j U_j = 0: U holomorphic in the triangle
-      const double a = w * W.x(), b = w * W.y();
+      const Vec2 W = p[(j + 2) % 3] - p[(j + 1) % 3];  // sum_j W_j z_j = 0: z holomorphic in the triangle
+      const Complex a(w * W.x(), w * W.y());
       const int vtx = c[j];
-      if (pinned[vtx]) {
-        const double u = plane[vtx].x(), v = plane[vtx].y();
-        rhs[re] -= a * u - b * v;
-        rhs[im] -= b * u + a * v;
-      } else {
-        entries.emplace_back(re, id[vtx], a);
-        entries.emplace_back(re, nfree + id[vtx], -b);
-        entries.emplace_back(im, id[vtx], b);
-        entries.emplace_back(im, nfree + id[vtx], a);
-      }
+      if (pinned[vtx])
+        rhs[row] -= a * Complex(plane[vtx].x(), plane[vtx].y());
+      else
+        entries.emplace_back(row, id[vtx], a);
     }
   }
-  Eigen::SparseMatrix<double> A(2 * static_cast<Eigen::Index>(nt), 2 * nfree);
+  Eigen::SparseMatrix<Complex> A(static_cast<Eigen::Index>(nt), nfree);
   A.setFromTriplets(entries.begin(), entries.end());
-  const Eigen::SparseMatrix<double> AtA = A.transpose() * A;
-  const Eigen::MatrixXd Atb = A.transpose() * rhs;
+  const Eigen::SparseMatrix<Complex> AhA = A.adjoint() * A;
+  const Eigen::MatrixXcd Ahb = A.adjoint() * rhs;
   timings->conformal_assembly = seconds_since(start);
-  Eigen::MatrixXd solution;
+  Eigen::MatrixXcd solution;
   SpdTimings spd;
-  const bool solved = solve_spd(AtA, Atb, &solution, &spd);
+  const bool solved = solve_hpd(AhA, Ahb, &solution, &spd);
   timings->conformal_ordering = spd.ordering;
   timings->conformal_factorisation = spd.factorisation;
   timings->conformal_solve = spd.solve;
   if (!solved) return false;
   start = std::chrono::steady_clock::now();
-  const Eigen::VectorXd x = solution.col(0);
   uv->resize(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) (*uv)[i] = pinned[i] ? plane[i] : Vec2(x[id[i]], x[nfree + id[i]]);
+  for (int i = 0; i < n; ++i)
+    (*uv)[i] = pinned[i] ? plane[i] : Vec2(solution(id[i], 0).real(), solution(id[i], 0).imag());
   double area2 = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     const Vec2 f1 = (*uv)[patch.triangles[3 * t + 1]] - (*uv)[patch.triangles[3 * t]];

@@ -1,8 +1,10 @@
 #pragma once
-// One sparse symmetric positive definite solve, shared by the background fill (background.cpp)
-// and the conformal flattening (height_map.cpp): CHOLMOD from SuiteSparse (which picks
-// supernodal or simplicial and the AMD or METIS ordering itself) when the build has it
-// (CMake option RELIEF_SNAKE_WITH_CHOLMOD), else Eigen's SimplicialLDLT.
+// One sparse symmetric (or Hermitian) positive definite solve, shared by the background fill
+// (background.cpp, real) and the conformal flattening (height_map.cpp, complex): CHOLMOD from
+// SuiteSparse (which picks supernodal or simplicial and the AMD or METIS ordering itself) when the
+// build has it (CMake option RELIEF_SNAKE_WITH_CHOLMOD), else Eigen's SimplicialLDLT.
+#include <complex>
+
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 
@@ -20,6 +22,12 @@ struct SpdTimings {
 /// the solve fails or X is not finite. timings, if given, gets the stages' times (summed over
 /// the attempts when CHOLMOD falls back to LDL^T).
 bool solve_spd(const Eigen::SparseMatrix<double>& A, const Eigen::MatrixXd& B, Eigen::MatrixXd* X,
+               SpdTimings* timings = nullptr);
+
+/// The same for a Hermitian positive definite A (both triangles stored) and complex B: the
+/// least-squares conformal map's normal equations, n complex unknowns instead of 2n real ones
+/// (a quarter of the factor's entries).
+bool solve_hpd(const Eigen::SparseMatrix<std::complex<double>>& A, const Eigen::MatrixXcd& B, Eigen::MatrixXcd* X,
                SpdTimings* timings = nullptr);
 
 /// "cholmod" or "eigen-simplicial-ldlt": which solver this build uses (for benchmarks and notes).
