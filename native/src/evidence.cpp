@@ -306,6 +306,10 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
   if (all.coarse_step_share >= options.min_step_share && all.coarse_iou < options.min_coarse_iou)
     check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(all.coarse_iou) +
                             ": refinement moved far from where the step was first found");
+  if (all.abandoned_area_share >= 0)
+    check.reasons.push_back("the refinement was stopped when the contour enclosed only " +
+                            percent(all.abandoned_area_share) +
+                            " of the area the coarse contour found: it was crossing the relief");
   if (all.area_ratio > options.max_area_ratio || all.area_ratio * options.max_area_ratio < 1)
     check.reasons.push_back("the relief region covers " + number(all.area_ratio) +
                             " times the area the contour encloses: the region leaked past the contour or lost a "

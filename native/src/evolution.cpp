@@ -238,6 +238,10 @@ PhaseOutcome run_phase(Snake& snake, FeatureEnergy& feature, const PhaseSettings
     // the contour (a few snaxels trading places with splits and merges), not
     // progress, and the phase has converged.
     if (iteration % phase.lock_interval == 0) {
+      if (phase.abandon && phase.abandon(snake)) {
+        outcome.abandoned = true;
+        return outcome;
+      }
       if (!checkpoint.empty() && snake.within(checkpoint, lock_distance)) {
         outcome.converged = true;
         return outcome;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "relief_snake/energy.hpp"
+#include "relief_snake/evidence.hpp"
 #include "relief_snake/evolution.hpp"
 
 namespace relief_snake {
@@ -108,10 +109,11 @@ const ScheduleRun& EvolutionSchedule::coarse(const ProgressCallback& progress) {
   return run;
 }
 
-ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& progress) {
+ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& progress, double min_area_share) {
   const ScheduleRun& first = coarse(progress);
   if (first.cancelled || first.collapsed) return first;
-  return refine_snake(*coarse_snake_, true, w_int, progress);  // each refinement starts from the coarse snake
+  // each refinement starts from the coarse snake
+  return refine_snake(*coarse_snake_, true, w_int, progress, min_area_share);
 }
 
 ScheduleRun EvolutionSchedule::refine_from(const std::vector<SurfacePoint>& start, double w_int,
@@ -124,7 +126,7 @@ ScheduleRun EvolutionSchedule::refine_from(const std::vector<SurfacePoint>& star
 }
 
 ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels, double w_int,
-                                            const ProgressCallback& progress) {
+                                            const ProgressCallback& progress, double min_area_share) {
   ScheduleRun run = coarse_run_;
   const DerivedParameters param = parameters(w_int);
 
@@ -144,8 +146,14 @@ ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels,
   refine.gamma_sigma2 = 0;
   refine = at_spacing(refine, param.refine_spacing);
 
+  const double coarse_area = min_area_share > 0 && options_.closed ? vector_area(start.polyline()).norm() : 0.0;
+  const auto area_share = [coarse_area](const Snake& s) { return vector_area(s.polyline()).norm() / coarse_area; };
+  if (coarse_area > 0)
+    refine.abandon = [&area_share, min_area_share](const Snake& s) { return area_share(s) < min_area_share; };
+
   PhaseSettings stabilise = refine;
   stabilise.name = "stabilise";
+  stabilise.abandon = nullptr;
   stabilise.w_int = 1;
   stabilise.w_d = 0;
 
@@ -188,6 +196,16 @@ ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels,
         return run;
       }
       stats.iterations += outcome.iterations;
+      if (outcome.abandoned) {
+        stats.converged = false;
+        stats.snaxels = snake.size();
+        stats.seconds = seconds_since(t_phase);
+        run.phases.push_back(stats);
+        run.abandoned = true;
+        run.abandoned_area_share = area_share(snake);
+        run.contour = snake.points();
+        return run;
+      }
       stats.converged = stats.converged && outcome.converged;
     }
     stats.snaxels = snake.size();

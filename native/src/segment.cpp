@@ -328,6 +328,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
       a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       a.evidence.coarse_step_share = coarse_step_share;
+      a.evidence.abandoned_area_share = a.run.abandoned ? a.run.abandoned_area_share : -1.0;
       a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
       if (options.closed) {
         std::vector<Vec3> polyline;
@@ -396,7 +397,11 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       Attempt a;
       a.h = h_try;
       a.w_int = w;
-      a.run = schedule.refine(w, progress);
+      // A refinement from a coarse contour on the step whose contour shrinks well below the
+      // coarse-overlap check's share (its region could not pass min_coarse_iou; 0.8 leaves room for
+      // vector areas against region areas) is crossing the relief: stop it there.
+      const double abandon_share = coarse_step_share >= self_check.min_step_share ? 0.8 * self_check.min_coarse_iou : 0.0;
+      a.run = schedule.refine(w, progress, abandon_share);
       a.parameters = schedule.parameters(w);
       ++result.attempts;
       if (a.run.cancelled) {

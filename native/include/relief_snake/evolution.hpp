@@ -23,6 +23,9 @@ struct PhaseSettings {
   int max_iterations = 3000;
   bool remove_loops = true;   ///< cut off self-intersection loops (not in the paper)
   int min_snaxels = 4;        ///< fewer means the snake collapsed
+  /// Asked every lock_interval iterations: true abandons the phase (PhaseOutcome::abandoned), e.g.
+  /// a refinement that is carrying the snake across the relief. Empty: never.
+  std::function<bool(const Snake&)> abandon;
 };
 
 struct PhaseOutcome {
@@ -30,6 +33,7 @@ struct PhaseOutcome {
   bool converged = false;
   bool cancelled = false;
   bool collapsed = false;
+  bool abandoned = false;  ///< PhaseSettings::abandon said so
 };
 
 /// Energy of snaxel i of `snake` if it were at candidate x (without

@@ -24,6 +24,11 @@ struct ScheduleRun {
   bool cancelled = false;              ///< the progress callback asked to stop
   bool collapsed = false;              ///< the snake collapsed (collapsed_phase says where)
   std::string collapsed_phase;
+  /// The refinement was stopped early: the contour's vector area fell below min_area_share of the
+  /// coarse contour's (refine()); abandoned_area_share is the share it had then. contour holds
+  /// where it was; no stabilisation ran.
+  bool abandoned = false;
+  double abandoned_area_share = 0;
   int refine_levels = 1;               ///< refinement spacings used
 };
 
@@ -42,7 +47,10 @@ class EvolutionSchedule {
   const ScheduleRun& coarse(const ProgressCallback& progress);
   /// Refinement and stabilisation with this W_int, from the coarse snake. Runs the
   /// coarse phase first if needed. The returned phases include the coarse one.
-  ScheduleRun refine(double w_int, const ProgressCallback& progress);
+  /// min_area_share > 0 (closed contours): abandon the refinement once the contour encloses less
+  /// than this share of the coarse contour's vector area (ScheduleRun::abandoned): it is carrying
+  /// the snake across the relief, and finishing it would only cost time.
+  ScheduleRun refine(double w_int, const ProgressCallback& progress, double min_area_share = 0);
   /// Refinement and stabilisation with this W_int from another start (a repaired contour, already
   /// near the step: only the finest spacing runs). Runs the coarse phase first if needed (its
   /// phase is reported like refine()'s).
@@ -59,7 +67,8 @@ class EvolutionSchedule {
   bool coarse_done_ = false;
   ScheduleRun coarse_run_;
   std::unique_ptr<Snake> coarse_snake_;  // as the coarse phase left it
-  ScheduleRun refine_snake(const Snake& start, bool all_levels, double w_int, const ProgressCallback& progress);
+  ScheduleRun refine_snake(const Snake& start, bool all_levels, double w_int, const ProgressCallback& progress,
+                           double min_area_share = 0);
 };
 
 }  // namespace relief_snake
