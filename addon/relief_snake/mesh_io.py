@@ -6,13 +6,14 @@ straight into them, which is the fast path for 100k+ vertices.
 
 Writes go through one path per mode, the one Blender's own tools use, so that undo sees a
 consistent mesh: in Edit Mode the live bmesh (its deform layer) and nothing else, in Object
-Mode the mesh data (VertexGroup.add/remove). An existing group is reused and cleared rather
-than removed and re-created, and an existing contour object keeps its identity: its curve
-data is refilled in place. (Removing and re-creating both in Edit Mode made Blender 3.4
+Mode the mesh data (VertexGroup.add/remove). An existing group is reused and emptied of the
+vertices it no longer holds rather than removed and re-created, and an existing contour object
+keeps its identity: its curve data is refilled in place. (Removing and re-creating both in Edit Mode made Blender 3.4
 segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real window.)
 """
 
 import contextlib
+import itertools
 import math
 import operator
 import os
@@ -341,12 +342,23 @@ def write_vertex_group(obj, name, indices):
     else:
         nv = len(obj.data.vertices)
         if nv and existed:
-            group.remove(list(range(nv)))
+            # Out go only the vertices that will not be in it: the ones that stay keep their weight
+            # record (REPLACE sets it to 1), where removing everyone first freed each record and
+            # add() allocated it again (a repeat Segment writes the same vertices again).
+            group.remove(_complement(nv, indices))
         if len(indices):
             group.add(list(indices), 1.0, 'REPLACE')
     if obj.vertex_groups.active_index != gi:
         obj.vertex_groups.active_index = gi
     return group
+
+
+def _complement(n, indices):
+    """The vertices 0..n-1 not in indices, ascending (itertools.compress: the scan runs in C)."""
+    outside = bytearray(b"\1") * n
+    for i in indices:
+        outside[i] = 0
+    return list(itertools.compress(range(n), outside))
 
 
 def _clear_active_group_in_edit_mode(obj):

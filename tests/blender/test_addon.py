@@ -125,6 +125,48 @@ def group_members(obj, name):
     return out
 
 
+def group_weights(obj, name):
+    """{vertex index: weight} of the vertex group `name`, from the edit bmesh in Edit Mode."""
+    gi = obj.vertex_groups[name].index
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(obj.data)
+        layer = bm.verts.layers.deform.active
+        if layer is None:
+            return {}
+        return {v.index: round(v[layer][gi], 6) for v in bm.verts if gi in v[layer]}
+    return {v.index: round(g.weight, 6) for v in obj.data.vertices for g in v.groups if g.group == gi}
+
+
+def set_weights(obj, name, weights):
+    """Give vertices {index: weight} in group `name`, as painting would (Edit Mode: the edit bmesh)."""
+    gi = obj.vertex_groups[name].index
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(obj.data)
+        layer = bm.verts.layers.deform.verify()
+        bm.verts.ensure_lookup_table()
+        for i, w in weights.items():
+            bm.verts[i][layer][gi] = w
+        return
+    for i, w in weights.items():
+        obj.vertex_groups[name].add([i], w, 'REPLACE')
+
+
+def delete_vertices(obj, indices):
+    """Delete vertices (and their faces) as an edit would; the selection and its history follow."""
+    edit = obj.mode == 'EDIT'
+    bm = bmesh.from_edit_mesh(obj.data) if edit else bmesh.new()
+    if not edit:
+        bm.from_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    bmesh.ops.delete(bm, geom=[bm.verts[i] for i in indices], context='VERTS')
+    if edit:
+        bmesh.update_edit_mesh(obj.data)
+    else:
+        bm.to_mesh(obj.data)
+        bm.free()
+        obj.data.update()
+
+
 def iou(a, b):
     a, b = set(a), set(b)
     return len(a & b) / max(1, len(a | b))
@@ -357,6 +399,81 @@ class SegmentOperator(AddonTestCase):
         self.assertEqual(seg(step_height=self.h), {'FINISHED'})
         bpy.ops.object.mode_set(mode='OBJECT')
         self.assertNotIn(3, group_members(self.obj, "Relief"))
+
+    def test_rewriting_a_group_leaves_exactly_the_new_vertices_at_weight_one(self):
+        # The group keeps its records for the vertices that stay (Object Mode removes only the
+        # others): what stays, what goes, what comes and a weight the user changed between runs.
+        io = addon().mesh_io
+        nv = len(self.obj.data.vertices)
+        other = self.obj.vertex_groups.new(name="Other")
+        other.add(list(range(0, nv, 5)), 0.25, 'REPLACE')
+        first, second = sorted(range(0, 300, 2)), sorted(range(150, 600, 3))
+        for mode in ('OBJECT', 'EDIT'):
+            bpy.ops.object.mode_set(mode=mode)
+            io.write_vertex_group(self.obj, "Relief", first)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(first, 1.0), mode)
+            io.write_vertex_group(self.obj, "Relief", second)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(second, 1.0), mode)
+            set_weights(self.obj, "Relief", {second[0]: 0.4, 1: 0.7})  # painted: a member, and an outsider
+            io.write_vertex_group(self.obj, "Relief", second)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(second, 1.0), mode)
+            io.write_vertex_group(self.obj, "Relief", [])
+            self.assertEqual(group_weights(self.obj, "Relief"), {}, mode)
+            self.assertEqual(group_weights(self.obj, "Other"), dict.fromkeys(range(0, nv, 5), 0.25), mode)
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertEqual([g.name for g in self.obj.vertex_groups], ["Other", "Relief"])
+
+    def _spy_engine(self):
+        """[(picks, result)] of every run_engine call the operator makes, until the test ends."""
+        api, calls = addon().api, []
+        real = api.run_engine
+
+        def spy(core, request, *args, **kwargs):
+            calls.append((list(request.picks), real(core, request, *args, **kwargs)))
+            return calls[-1][1]
+        api.run_engine = spy
+        self.addCleanup(setattr, api, "run_engine", real)
+        return calls
+
+    def test_each_run_uses_the_click_order_of_its_own_selection(self):
+        # The same vertices picked again in another order between two runs (the mesh unchanged,
+        # so the engine's mesh is reused): the second run segments from the new order.
+        calls = self._spy_engine()
+        for mode in ('OBJECT', 'EDIT'):
+            bpy.ops.object.mode_set(mode=mode)
+            for order in (self.picks, self.picks[5:] + self.picks[:5], self.picks[::-1]):
+                select_vertices(self.obj, order)
+                self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+                self.assertEqual(calls[-1][0], order, mode)
+        self.assertTrue(all(result["mesh_cached"] for _, result in calls[1:]))
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_an_edit_between_runs_moves_the_group_with_the_vertices(self):
+        # Three corner vertices deleted between two runs: every later index shifts, the engine's
+        # cached mesh no longer fits (new fingerprint) and the group lands on the shifted vertices.
+        calls = self._spy_engine()
+        for mode in ('OBJECT', 'EDIT'):
+            clear_scene()
+            self.obj = make_scan_object()
+            bpy.ops.object.mode_set(mode=mode)
+            select_vertices(self.obj, self.picks)
+            self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+            first = calls[-1][1]["relief_vertices"]
+            gone = [0, 1, 2]  # a corner of the scan, far from the relief
+            delete_vertices(self.obj, gone)
+
+            def moved(i):
+                return i - sum(1 for g in gone if g < i)
+            self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+            picks, result = calls[-1]
+            self.assertEqual(picks, [moved(i) for i in self.picks], mode)
+            self.assertFalse(result["mesh_cached"], mode)
+            bpy.ops.object.mode_set(mode='OBJECT')
+            members = group_members(self.obj, "Relief")
+            self.assertEqual(members, set(result["relief_vertices"]), mode)
+            self.assertGreaterEqual(iou(members, [moved(i) for i in first]), 0.99, mode)
+            self.assertGreaterEqual(iou(members, [moved(i) for i in self.truth["relief_vertices"]]), IOU_MIN, mode)
 
     def test_edit_mode_undo_and_redo(self):
         bpy.ops.object.mode_set(mode='EDIT')
