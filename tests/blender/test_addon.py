@@ -1452,6 +1452,34 @@ class SeveralReliefsModal(AddonTestCase):
                         recorder.statuses)
         self.assertIn(({'INFO'}, "%d candidates found" % len(big)), reports)
 
+    def test_detect_reports_its_first_stages_and_counts_the_candidates(self):
+        # The engine calls progress while it fits the background and once it knows the candidates,
+        # before any refinement; the status bar says so, then "candidate k of n".
+        cls = addon().multi.MESH_OT_relief_snake_detect
+        op, _ = self.make_operator(cls)
+        obj, vertices, triangles, work, _total = op._read(_WindowContext(_WindowRecorder()))
+        calls = []
+        doc = work(addon().api.load_core().Mesh(vertices, triangles),
+                   lambda index, phase, iteration, snaxels, contour: calls.append((phase, iteration, index)) or True)
+        phases = [c[0] for c in calls]
+        self.assertEqual(phases[:4], ["background"] * 3 + ["candidates"], phases[:8])
+        self.assertNotIn("background", phases[4:])
+        found = calls[3][1]
+        self.assertGreaterEqual(found, len(doc["candidates"]))
+        self.assertEqual(op._found, [found])
+        self.assertEqual({c[2] for c in calls[4:]}, set(range(found)))  # each candidate refined after the count
+        Snapshot = addon().job.Snapshot
+        self.assertIn("fitting the background", op._status_text(Snapshot("background", 1, seconds=2.0)))
+        self.assertIn("%d candidates above the background" % found,
+                      op._status_text(Snapshot("candidates", found, seconds=2.0)))
+        self.assertIn("candidate 2 of %d: refining" % found, op._status_text(Snapshot("refine", 10, 40, index=1)))
+        # Cancelled while the background is fitted: the engine stops there, before any refinement.
+        calls.clear()
+        with self.assertRaises(addon().api.load_core().Cancelled):
+            work(addon().api.load_core().Mesh(vertices, triangles),
+                 lambda index, phase, iteration, snaxels, contour: calls.append(phase) or False)
+        self.assertEqual(calls, ["background"])
+
     def test_detect_esc_leaves_everything_as_it_was(self):
         items = bpy.context.scene.relief_snake_candidates
         items.add().name = "An earlier candidate"
