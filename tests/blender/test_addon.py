@@ -301,14 +301,35 @@ class SegmentOperator(AddonTestCase):
         bpy.ops.object.mode_set(mode='OBJECT')
 
     def test_edit_mode_geometry_changes_are_seen(self):
+        # Every read after an edit, the first (through to_mesh) and the later ones (the depsgraph's
+        # mesh that to_mesh converted, read in place), gives the edit mesh as it is.
         bpy.ops.object.mode_set(mode='EDIT')
-        bm = bmesh.from_edit_mesh(self.obj.data)
-        bm.verts.ensure_lookup_table()
-        bm.verts[0].co.z += 123.0
-        bmesh.update_edit_mesh(self.obj.data)
         api = addon().api
-        request = api.prepare(self.obj, self.picks, self.h)
-        self.assertAlmostEqual(request.vertices[2], _CFG["vertices"][0][2] + 123.0, places=3)
+
+        def edit(vertex, dz):
+            bm = bmesh.from_edit_mesh(self.obj.data)
+            bm.verts.ensure_lookup_table()
+            bm.verts[vertex].co.z += dz
+            bmesh.update_edit_mesh(self.obj.data)
+
+        def evaluated_copy():
+            evaluated = self.obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            mesh = evaluated.to_mesh()
+            try:
+                return addon().mesh_io.read_buffers(mesh)
+            finally:
+                evaluated.to_mesh_clear()
+        edit(0, 123.0)
+        for step in (None, (7, 5.0), None, (11, -2.0)):
+            if step:
+                edit(*step)
+            first = api.prepare(self.obj, self.picks, self.h)
+            again = api.prepare(self.obj, self.picks, self.h)
+            self.assertEqual(first.digest, again.digest)
+            self.assertEqual(first.digest, addon().job.fingerprint(*evaluated_copy()))
+            self.assertAlmostEqual(again.vertices[2], _CFG["vertices"][0][2] + 123.0, places=3)
+        self.assertAlmostEqual(again.vertices[3 * 7 + 2], _CFG["vertices"][7][2] + 5.0, places=3)
+        self.assertAlmostEqual(again.vertices[3 * 11 + 2], _CFG["vertices"][11][2] - 2.0, places=3)
         bpy.ops.object.mode_set(mode='OBJECT')
 
     def test_second_run_replaces_group_and_curve(self):
