@@ -1195,7 +1195,7 @@ class ModalPath(AddonTestCase):
                 reports.append((set(kind), text))
 
         for name in ("modal", "_modal_step", "_start", "_prepare", "_finish", "_cleanup", "_status", "_current_run",
-                     "_set_current_run"):
+                     "_set_current_run", "_hold_edit_bmesh", "_release_edit_bmesh"):
             setattr(Stand_in, name, getattr(cls, name))
         op = Stand_in()
         s = bpy.context.scene.relief_snake
@@ -1233,6 +1233,32 @@ class ModalPath(AddonTestCase):
         self.assertIn(("progress_end",), recorder.calls)
         self.assertCleanedUp(cls, op, recorder)
         self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_edit_mode_holds_one_bmesh_handle_from_the_read_to_the_write(self):
+        # The read and the write share one handle (mesh_io.hold_edit_bmesh), dropped once the
+        # weights are written; leaving Edit Mode while it is held (Blender frees the edit bmesh)
+        # only invalidates it, and the run still writes, now through the mesh data.
+        for leave in (False, True):
+            clear_scene()
+            self.obj = make_scan_object()
+            bpy.ops.object.mode_set(mode='EDIT')
+            select_vertices(self.obj, self.picks)
+            cls, op, reports = self.make_operator(step_height=self.h, estimate_step_height=False)
+            recorder = _Recorder()
+            context = _Context(recorder)
+            self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})  # read, worker started
+            self.assertIsNotNone(op._held_bmesh)
+            self.assertIs(bmesh.from_edit_mesh(self.obj.data), op._held_bmesh)
+            if leave:
+                bpy.ops.object.mode_set(mode='OBJECT')
+                self.assertFalse(op._held_bmesh.is_valid)
+            ret = self.tick_until_done(op, context)
+            self.assertEqual(ret, {'FINISHED'}, reports)
+            self.assertIsNone(op._held_bmesh)
+            self.assertCleanedUp(cls, op, recorder)
+            if not leave:
+                bpy.ops.object.mode_set(mode='OBJECT')
+            self.assertSegmentationMatchesTruth(self.obj)
 
     def test_esc_cancels_and_writes_nothing(self):
         select_vertices(self.obj, self.picks)
