@@ -8,8 +8,9 @@ Writes go through one path per mode, the one Blender's own tools use, so that un
 consistent mesh: in Edit Mode the live bmesh (its deform layer) and nothing else, in Object
 Mode the mesh data (VertexGroup.add/remove). An existing group is reused and emptied of the
 vertices it no longer holds rather than removed and re-created, and an existing contour object
-keeps its identity: its curve data is refilled in place. (Removing and re-creating both in Edit Mode made Blender 3.4
-segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real window.)
+keeps its identity: its curve data is refilled in place. (Removing and re-creating both in Edit
+Mode made Blender 3.4 segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a
+real window.)
 """
 
 import contextlib
@@ -25,8 +26,9 @@ import bmesh
 
 from . import blend_history
 
-__all__ = ["sync_edit_mode", "live_mesh", "hold_edit_bmesh", "read_buffers", "read_selection", "vertex_position", "live_vertex_count",
-           "write_vertex_group", "write_curve", "contour_object_name", "forget_memory_layout", "CONTOUR_COLOR"]
+__all__ = ["sync_edit_mode", "live_mesh", "hold_edit_bmesh", "read_buffers", "read_selection", "vertex_position",
+           "live_vertex_count", "write_vertex_group", "write_curve", "contour_object_name", "forget_memory_layout",
+           "CONTOUR_COLOR"]
 
 CONTOUR_COLOR = (1.0, 0.32, 0.02, 1.0)  # a clear orange, unlike any of Blender's overlay colours
 _MATERIAL = "Relief Snake Contour"
