@@ -1,5 +1,4 @@
-"""A mesh's click order (its MSelect array) read from a .blend file, or with that file's layout from
-the running Blender's memory; without bpy (plain Python).
+"""A mesh's click order (its MSelect array) read from a .blend file, without bpy (plain Python).
 
 In Object Mode Blender keeps the select history with the mesh data (Mesh.mselect), and its Python
 API reads it back only through bmesh, which copies the whole mesh (0.7 s of a 300k-triangle
@@ -13,26 +12,12 @@ Both file layouts are read: the one of Blender 2.5 to 4.x ("BLENDER-v304", 24-by
 headers with 8-byte pointers, 20 with 4-byte ones) and the one of Blender 5.0+ ("BLENDER17-01v0500",
 32-byte block headers). Anything unexpected raises Unreadable, so that the caller falls back to
 bmesh: this module never guesses.
-
-The SDNA a Blender writes is its own structs' memory layout (a .blend stores the structs as they
-are in memory). So the same offsets also find a live mesh's history in the running Blender's own
-memory, from the Mesh's address (bpy's Mesh.as_pointer()), in microseconds:
-
-    entries, layout = read_select_history_and_layout(path, "MEScan")   # once, from a file it wrote
-    entries = select_history_in_memory(mesh.as_pointer(), "MEScan", layout, limit)
-
-The caller trusts a layout only after the memory read of the mesh it came from gave the same
-entries as the file (mesh_io does), and every memory read checks the ID name at its offset and
-totselect against the mesh's size first.
 """
 
-import ctypes
 import mmap
 import struct
-import sys
 
-__all__ = ["Unreadable", "read_select_history", "read_select_history_and_layout", "MemoryLayout",
-           "select_history_in_memory", "VERTEX", "EDGE", "FACE"]
+__all__ = ["Unreadable", "read_select_history", "VERTEX", "EDGE", "FACE"]
 
 VERTEX, EDGE, FACE = 0, 1, 2  # MSelect.type: ME_VSEL, ME_ESEL, ME_FSEL
 
@@ -208,12 +193,6 @@ def read_select_history(path, id_name):
     """[(index, type)] of the MSelect array of the Mesh block named id_name (the ID name with its
     two-letter code, e.g. "MEScan") in the .blend at path, in click order as stored (duplicates and
     all). Raises Unreadable if the file is not laid out as expected or holds no such mesh."""
-    return read_select_history_and_layout(path, id_name)[0]
-
-
-def read_select_history_and_layout(path, id_name):
-    """(entries, layout): read_select_history's entries, and the MemoryLayout of the file's SDNA
-    (where the Blender that wrote the file keeps a mesh's history in its memory)."""
     try:
         with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
             return _read(data, id_name)  # mapped, not read: only a few blocks of it are looked at
@@ -223,54 +202,10 @@ def read_select_history_and_layout(path, id_name):
         raise Unreadable("malformed .blend: %s" % exc) from None
 
 
-class MemoryLayout:
-    """Where a Blender keeps a Mesh's select history in memory: the offsets of the Mesh struct's ID
-    name, mselect pointer and totselect count, MSelect's size and fields (from a file's SDNA), and
-    that file's pointer size and byte order."""
-
-    def __init__(self, offsets, pointer, endian):
-        self.offsets, self.pointer, self.endian = dict(offsets), pointer, endian
-
-    def __eq__(self, other):
-        return isinstance(other, MemoryLayout) and (self.offsets, self.pointer, self.endian) == \
-            (other.offsets, other.pointer, other.endian)
-
-    def __repr__(self):
-        return "MemoryLayout(%r, pointer=%d, endian=%r)" % (self.offsets, self.pointer, self.endian)
-
-
-def select_history_in_memory(address, id_name, layout, limit):
-    """[(index, type)] of the MSelect array of the Mesh struct at `address` in this process's
-    memory (bpy's Mesh.as_pointer()), found with `layout` (read_select_history_and_layout's, from a
-    file this same Blender wrote). id_name: the mesh's ID name ("MEScan"); limit: the most entries
-    a history of that mesh can hold (#vertices + #edges + #faces). Raises Unreadable when the
-    layout is not this process's (pointer size, byte order), when the ID name is not found at its
-    offset, or when totselect or the array pointer are out of range: nothing is read past them."""
-    native = "<" if sys.byteorder == "little" else ">"
-    if layout.pointer != ctypes.sizeof(ctypes.c_void_p) or layout.endian != native:
-        raise Unreadable("the layout is not this process's (pointer size %d, byte order %r)"
-                         % (layout.pointer, layout.endian))
-    if not address:
-        raise Unreadable("no mesh address")
-    off = layout.offsets
-    wanted = id_name.encode("utf-8") + b"\0"
-    if ctypes.string_at(address + off["name"], len(wanted)) != wanted:
-        raise Unreadable("the mesh's ID name is not where the layout puts it")
-    total = ctypes.c_int.from_address(address + off["totselect"]).value
-    pointer = ctypes.c_void_p.from_address(address + off["mselect"]).value
-    if total == 0:
-        return []
-    if not 0 < total <= limit or not pointer:
-        raise Unreadable("totselect %d (at most %d) with array %s" % (total, limit, hex(pointer or 0)))
-    step = off["msel_size"]
-    return _entries(ctypes.string_at(pointer, total * step), total, layout, off)
-
-
 def _read(data, id_name):
     layout = _Layout(data[:17])
     at, length = _find_dna(data, layout)
     offsets = _mesh_layout(_sdna(data[at:at + length], layout.endian, layout.pointer))
-    memory = MemoryLayout(offsets, layout.pointer, layout.endian)
     wanted = None  # (mselect pointer, totselect) once the mesh's block is found
     # Blender writes a mesh's select history right after the mesh's own block, before its
     # attribute arrays and weights: the walk stops there.
@@ -279,13 +214,13 @@ def _read(data, id_name):
             found = _mesh_select(data[pos:pos + length], id_name, layout, offsets)
             if found is not None:
                 if found[1] <= 0 or found[0] == 0:
-                    return [], memory
+                    return []
                 wanted = found
         elif wanted is not None and code == b"DATA" and old == wanted[0]:
             n = wanted[1]
             if length < n * offsets["msel_size"]:
                 raise Unreadable("the mesh's select history block is short")
-            return _entries(data[pos:pos + n * offsets["msel_size"]], n, layout, offsets), memory
+            return _entries(data[pos:pos + n * offsets["msel_size"]], n, layout, offsets)
     raise Unreadable("no mesh %r with its select history in the file" % id_name)
 
 
@@ -303,7 +238,7 @@ def _mesh_select(block, id_name, layout, offsets):
     return pointer, total
 
 
-def _entries(raw, total, layout, offsets):  # layout: a _Layout or a MemoryLayout (its .endian)
+def _entries(raw, total, layout, offsets):
     e, step = layout.endian + "i", offsets["msel_size"]
     return [(struct.unpack_from(e, raw, k * step + offsets["index"])[0],
              struct.unpack_from(e, raw, k * step + offsets["type"])[0]) for k in range(total)]

@@ -27,8 +27,7 @@ import bmesh
 from . import blend_history
 
 __all__ = ["sync_edit_mode", "live_mesh", "hold_edit_bmesh", "read_buffers", "read_selection", "vertex_position",
-           "live_vertex_count", "write_vertex_group", "write_curve", "contour_object_name", "forget_memory_layout",
-           "CONTOUR_COLOR"]
+           "live_vertex_count", "write_vertex_group", "write_curve", "contour_object_name", "CONTOUR_COLOR"]
 
 CONTOUR_COLOR = (1.0, 0.32, 0.02, 1.0)  # a clear orange, unlike any of Blender's overlay colours
 _MATERIAL = "Relief Snake Contour"
@@ -184,36 +183,10 @@ def _history_file_dirs():
     return ([shm] if os.path.isdir(shm) and os.access(shm, os.W_OK) else []) + [None]
 
 
-# Where this Blender keeps a mesh's select history in memory (blend_history.MemoryLayout), learnt
-# from the first scratch file and trusted once the memory read of that file's mesh gave the same
-# entries: from then on the history is read from memory, with no file. None until then.
-_memory_layout = None
-
-
-def forget_memory_layout():
-    """Read the click order through scratch files again until a file confirms the layout anew (tests)."""
-    global _memory_layout
-    _memory_layout = None
-
-
-def _history_limit(mesh):
-    return len(mesh.vertices) + len(mesh.edges) + len(mesh.polygons)
-
-
 def _stored_history(mesh):
-    """The mesh's MSelect array [(index, type)] as stored. From Blender's memory once a scratch file
-    confirmed where it is (microseconds); else through a scratch .blend of the mesh alone
-    (bpy.data.libraries.write: a block copy of its arrays, no bmesh) read back by blend_history,
-    whose layout is then checked against memory. None if neither could be done (the caller reads
-    it through bmesh)."""
-    global _memory_layout
-    id_name = "ME" + mesh.name
-    if _memory_layout is not None:
-        try:
-            return blend_history.select_history_in_memory(mesh.as_pointer(), id_name, _memory_layout,
-                                                          _history_limit(mesh))
-        except blend_history.Unreadable:
-            _memory_layout = None  # it does not fit this mesh: the file decides, and checks anew
+    """The mesh's MSelect array [(index, type)] as stored, through a scratch .blend of the mesh
+    alone (bpy.data.libraries.write: a block copy of its arrays, no bmesh) read back by
+    blend_history. None if that could not be done (the caller reads it through bmesh)."""
     for folder in _history_file_dirs():
         try:
             fd, path = tempfile.mkstemp(prefix="relief-snake-", suffix=".blend", dir=folder)
@@ -225,18 +198,12 @@ def _stored_history(mesh):
                 bpy.data.libraries.write(path, {mesh}, compress=False)
             except (OSError, RuntimeError):  # e.g. a /dev/shm too small for the mesh: the next folder
                 continue
-            entries, layout = blend_history.read_select_history_and_layout(path, id_name)
+            return blend_history.read_select_history(path, "ME" + mesh.name)
         except (blend_history.Unreadable, OSError, TypeError, ValueError):
             return None
         finally:
             with contextlib.suppress(OSError):
                 os.remove(path)
-        if _memory_layout is None and entries:  # an empty history would confirm no pointer
-            with contextlib.suppress(blend_history.Unreadable):
-                if blend_history.select_history_in_memory(mesh.as_pointer(), id_name, layout,
-                                                          _history_limit(mesh)) == entries:
-                    _memory_layout = layout
-        return entries
     return None
 
 
@@ -262,9 +229,8 @@ def _click_order(obj, flags):
         bm.verts.index_update()
         return [e.index for e in bm.select_history if isinstance(e, bmesh.types.BMVert) and e.select]
     # Object Mode: the click order is stored with the mesh (MSelect) and bmesh is the only reader
-    # in the Python API, at the price of a copy of the whole mesh. The .blend and memory routes read
-    # the same array; it is filtered as bmesh does (vertex entries, the first of duplicates, selected
-    # ones).
+    # in the Python API, at the price of a copy of the whole mesh. The .blend route reads the same
+    # array; it is filtered as bmesh does (vertex entries, the first of duplicates, selected ones).
     entries = _stored_history(mesh)
     if entries is None:
         return _bmesh_history(mesh)

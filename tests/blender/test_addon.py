@@ -736,11 +736,10 @@ def _bmesh_click_order(mesh):
         bm.free()
 
 
-class _ClickOrderBehaviour:
-    """What Object Mode's click order reading must do, whichever route reads the mesh's MSelect
-    array (a scratch .blend, or Blender's memory once a file confirmed the layout): equal bmesh's
-    reading for any history and follow every change of it. It is read again on every Segment (no
-    cache), because nothing cheap tells whether the order changed."""
+class ObjectModeClickOrder(AddonTestCase):
+    """Object Mode reads the click order (the mesh's MSelect array) from a scratch .blend of the mesh
+    (mesh_io._stored_history) instead of a bmesh copy. It is read again on every Segment (no cache),
+    so it must equal bmesh's reading for any history and follow every change of it."""
 
     def history(self):
         return addon().mesh_io.read_selection(self.obj)[1]
@@ -821,47 +820,12 @@ class _ClickOrderBehaviour:
         # An empty history with a selection: nothing, and the operator falls back to angles.
         self.set_history([], selected=order)
         self.assertEqual(self.history(), [])
-        # And a history again after the empty one (the array was freed and allocated anew).
-        self.set_history(order[::-1])
-        self.assertEqual(self.history(), order[::-1])
 
     def test_a_renamed_or_long_named_mesh(self):
         order = self.picks[:4]
         select_vertices(self.obj, order)
         self.obj.data.name = "Scan with a long name: " + "x" * 30
         self.assertEqual(self.history(), order)
-
-    def test_two_meshes_keep_their_own_order(self):
-        other = make_scan_object("Scan2")
-        select_vertices(self.obj, self.picks[:5])
-        select_vertices(other, self.picks[5:9])
-        self.assertEqual(self.history(), self.picks[:5])
-        self.assertEqual(addon().mesh_io.read_selection(other)[1], self.picks[5:9])
-
-    def test_operator_in_object_mode_uses_the_click_order(self):
-        select_vertices(self.obj, self.picks)
-        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
-        self.assertSegmentationMatchesTruth(self.obj)
-        self.assertEqual(self.history(), self.picks)  # the group and curve written did not disturb it
-
-
-class ObjectModeClickOrder(_ClickOrderBehaviour, AddonTestCase):
-    """The scratch .blend route: the memory route is kept out (it never confirms a layout)."""
-
-    def setUp(self):
-        super().setUp()
-        blend = addon().blend_history
-        self._real_memory = blend.select_history_in_memory
-
-        def refused(*args):
-            raise blend.Unreadable("kept out by the test")
-        blend.select_history_in_memory = refused
-        addon().mesh_io.forget_memory_layout()
-
-    def tearDown(self):
-        addon().blend_history.select_history_in_memory = self._real_memory
-        self.assertIsNone(addon().mesh_io._memory_layout)
-        super().tearDown()
 
     def test_a_folder_that_cannot_be_written_is_skipped(self):
         order = self.picks[:5]
@@ -881,15 +845,15 @@ class ObjectModeClickOrder(_ClickOrderBehaviour, AddonTestCase):
         order = self.picks[:5]
         select_vertices(self.obj, order)
         blend = addon().blend_history
-        real = blend.read_select_history_and_layout
+        real = blend.read_select_history
 
         def broken(path, name):
             raise blend.Unreadable("a layout this reader does not know")
-        blend.read_select_history_and_layout = broken
+        blend.read_select_history = broken
         try:
             self.assertEqual(self.history(), order)
         finally:
-            blend.read_select_history_and_layout = real
+            blend.read_select_history = real
 
     def test_the_scratch_file_leaves_no_trace(self):
         select_vertices(self.obj, self.picks[:4])
@@ -908,46 +872,11 @@ class ObjectModeClickOrder(_ClickOrderBehaviour, AddonTestCase):
         self.assertEqual([m.name for m in bpy.data.meshes], names)
         self.assertEqual((self.obj.data.users, bpy.data.is_dirty), (users, dirty))
 
-
-class ObjectModeClickOrderFromMemory(_ClickOrderBehaviour, AddonTestCase):
-    """The memory route: once a scratch file's reading and the memory reading agreed, the history is
-    read from memory and no scratch file is written (every test checks that)."""
-
-    def setUp(self):
-        super().setUp()
-        io = addon().mesh_io
-        io.forget_memory_layout()
-        select_vertices(self.obj, self.picks[:3])
-        self.assertEqual(self.history(), self.picks[:3])  # through a scratch file, which confirms the layout
-        self.assertIsNotNone(io._memory_layout, "the scratch file's layout was not confirmed in memory")
-        self._real_dirs, self._files = io._history_file_dirs, []
-        io._history_file_dirs = lambda: self._files.append(1) or self._real_dirs()
-
-    def tearDown(self):
-        addon().mesh_io._history_file_dirs = self._real_dirs
-        self.assertEqual(self._files, [], "a scratch file was written after the layout was confirmed")
-        super().tearDown()
-
-    def test_an_empty_history_confirms_nothing(self):
-        io = addon().mesh_io
-        io._history_file_dirs = self._real_dirs  # this test reads through files on purpose
-        io.forget_memory_layout()
-        self.set_history([], selected=self.picks[:3])
-        self.assertEqual(self.history(), [])
-        self.assertIsNone(io._memory_layout)  # no array, no pointer: nothing was checked
-        self.set_history(self.picks[:3])
-        self.assertEqual(self.history(), self.picks[:3])
-        self.assertIsNotNone(io._memory_layout)
-
-    def test_a_layout_that_does_not_fit_is_dropped_for_the_file(self):
-        io, blend = addon().mesh_io, addon().blend_history
-        io._history_file_dirs = self._real_dirs  # the file decides here
-        good = io._memory_layout
-        offsets = dict(good.offsets, name=good.offsets["name"] + 8)  # the ID name is not found there
-        io._memory_layout = blend.MemoryLayout(offsets, good.pointer, good.endian)
-        select_vertices(self.obj, self.picks[:4])
-        self.assertEqual(self.history(), self.picks[:4])
-        self.assertEqual(io._memory_layout, good)  # learnt anew from the file and confirmed
+    def test_operator_in_object_mode_uses_the_click_order(self):
+        select_vertices(self.obj, self.picks)
+        self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+        self.assertSegmentationMatchesTruth(self.obj)
+        self.assertEqual(self.history(), self.picks)  # the group and curve written did not disturb it
 
 
 class MeasureAndApi(AddonTestCase):

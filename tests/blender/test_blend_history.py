@@ -3,7 +3,6 @@ Blenders, where test_addon.py also reads real files against bmesh): small .blend
 each block layout, with an SDNA that places the fields elsewhere than Blender does, so that only a
 reader that follows the file's own SDNA finds the history."""
 
-import ctypes
 import os
 import struct
 import sys
@@ -153,64 +152,6 @@ class ReadSelectHistory(unittest.TestCase):
         w3.add(b"DATA", _selection("<", [(1, 0)]), old=0x5000)
         with self.assertRaises(blend_history.Unreadable):
             self.read(w3.build())
-
-
-class SelectHistoryInMemory(unittest.TestCase):
-    """The memory route: a Mesh struct and its MSelect array built in this process's memory in the
-    layout of a file's SDNA (the 'old8' layout is this machine's: 8-byte pointers, little-endian),
-    read at their address with the layout read_select_history_and_layout took from the file."""
-
-    def setUp(self):
-        self.assertEqual((ctypes.sizeof(ctypes.c_void_p), sys.byteorder), (8, "little"))
-        fd, path = tempfile.mkstemp(suffix=".blend")
-        os.close(fd)
-        self.addCleanup(os.remove, path)
-        self.writer = _Writer("old8", pad_before_mselect=40)
-        entries = [(12, 0), (840, 0), (5, 2)]
-        self.writer.add(b"ME\0\0", self.writer.mesh("MEScan", 0x5000, len(entries)), old=0x4000)
-        self.writer.add(b"DATA", _selection("<", entries), old=0x5000)
-        with open(path, "wb") as f:
-            f.write(self.writer.build())
-        got, self.layout = blend_history.read_select_history_and_layout(path, "MEScan")
-        self.assertEqual(got, entries)
-        self.keep = []
-
-    def mesh_at(self, name, entries, total=None, null=False):
-        """The address of a Mesh struct named `name` whose history is `entries` (totselect `total`)."""
-        array = ctypes.create_string_buffer(_selection("<", entries) or b"\0" * 8)
-        pointer = 0 if null else ctypes.addressof(array)
-        mesh = ctypes.create_string_buffer(self.writer.mesh(name, pointer, len(entries) if total is None else total))
-        self.keep += [array, mesh]
-        return ctypes.addressof(mesh)
-
-    def test_reads_the_history_at_the_layout_offsets(self):
-        entries = [(7, 0), (3, 0), (99, 1), (7, 0)]
-        self.assertEqual(blend_history.select_history_in_memory(self.mesh_at("MEScan", entries), "MEScan",
-                                                                self.layout, 100), entries)
-        self.assertEqual(blend_history.select_history_in_memory(self.mesh_at("MEScan", []), "MEScan",
-                                                                self.layout, 100), [])
-
-    def test_what_it_refuses(self):
-        read = blend_history.select_history_in_memory
-        cases = {
-            "another mesh's name": lambda: read(self.mesh_at("MEOther", [(1, 0)]), "MEScan", self.layout, 100),
-            "a longer name": lambda: read(self.mesh_at("MEScan", [(1, 0)]), "MEScanned", self.layout, 100),
-            "more entries than the mesh has elements": lambda: read(self.mesh_at("MEScan", [(1, 0)] * 5), "MEScan",
-                                                                    self.layout, 4),
-            "a negative count": lambda: read(self.mesh_at("MEScan", [(1, 0)], total=-1), "MEScan", self.layout, 100),
-            "entries without an array": lambda: read(self.mesh_at("MEScan", [(1, 0)], null=True), "MEScan",
-                                                     self.layout, 100),
-            "no address": lambda: read(0, "MEScan", self.layout, 100),
-            "another process's pointer size": lambda: read(
-                self.mesh_at("MEScan", [(1, 0)]), "MEScan",
-                blend_history.MemoryLayout(self.layout.offsets, 4, self.layout.endian), 100),
-            "another byte order": lambda: read(
-                self.mesh_at("MEScan", [(1, 0)]), "MEScan",
-                blend_history.MemoryLayout(self.layout.offsets, 8, ">"), 100),
-        }
-        for why, call in cases.items():
-            with self.assertRaises(blend_history.Unreadable, msg=why):
-                call()
 
 
 if __name__ == "__main__":
