@@ -6,13 +6,15 @@ straight into them, which is the fast path for 100k+ vertices.
 
 Writes go through one path per mode, the one Blender's own tools use, so that undo sees a
 consistent mesh: in Edit Mode the live bmesh (its deform layer) and nothing else, in Object
-Mode the mesh data (VertexGroup.add/remove). An existing group is reused and cleared rather
-than removed and re-created, and an existing contour object keeps its identity: its curve
-data is refilled in place. (Removing and re-creating both in Edit Mode made Blender 3.4
-segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a real window.)
+Mode the mesh data (VertexGroup.add/remove). An existing group is reused and emptied of the
+vertices it no longer holds rather than removed and re-created, and an existing contour object
+keeps its identity: its curve data is refilled in place. (Removing and re-creating both in Edit
+Mode made Blender 3.4 segfault on the next Ctrl+Z; tests/blender/ui/ replays that sequence in a
+real window.)
 """
 
 import contextlib
+import itertools
 import math
 import operator
 import os
@@ -24,8 +26,8 @@ import bmesh
 
 from . import blend_history
 
-__all__ = ["sync_edit_mode", "live_mesh", "read_buffers", "read_selection", "vertex_position", "live_vertex_count",
-           "write_vertex_group", "write_curve", "contour_object_name", "CONTOUR_COLOR"]
+__all__ = ["sync_edit_mode", "live_mesh", "hold_edit_bmesh", "read_buffers", "read_selection", "vertex_position",
+           "live_vertex_count", "write_vertex_group", "write_curve", "contour_object_name", "CONTOUR_COLOR"]
 
 CONTOUR_COLOR = (1.0, 0.32, 0.02, 1.0)  # a clear orange, unlike any of Blender's overlay colours
 _MATERIAL = "Relief Snake Contour"
@@ -48,20 +50,31 @@ def _evaluated_is_edit_mesh(obj):
 def live_mesh(obj):
     """The mesh data the user sees now, to read from (never to write to).
 
-    Object Mode: obj.data. Edit Mode: the depsgraph's mesh of the edit mesh (object.to_mesh()).
-    Blender converts the edit mesh into it once per edit and keeps it, so reading an unchanged
-    edit mesh again costs a copy, where update_from_editmode() writes the whole edit mesh back
-    into obj.data on every call (1.3 s of a 300k-triangle Segment in Blender 3.4). When modifiers
-    or shape keys make that mesh differ from the edit mesh, obj.data is flushed as before.
+    Object Mode: obj.data. Edit Mode: the depsgraph's mesh of the edit mesh (object.to_mesh(), or
+    the evaluated object's mesh itself once a to_mesh() converted it). Blender converts the edit
+    mesh into it once per edit and keeps it, so reading an unchanged edit mesh again costs no
+    conversion, where update_from_editmode() writes the whole edit mesh back into obj.data on
+    every call (1.3 s of a 300k-triangle Segment in Blender 3.4). When modifiers or shape keys
+    make that mesh differ from the edit mesh, obj.data is flushed as before.
     """
     if obj.mode != 'EDIT':
         yield obj.data
         return
     if _evaluated_is_edit_mesh(obj):
         evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        n = len(bmesh.from_edit_mesh(obj.data).verts)
+        # 3.x: the depsgraph's mesh itself, once an earlier to_mesh() converted it (in place, kept
+        # until the next edit), read there without to_mesh()'s copy of the whole mesh (0.01 s at
+        # 300k triangles in 3.4). Until then it is a wrapper of the edit mesh with no vertices of its
+        # own. 4.0+ copies nothing (the copy shares the arrays), and there the evaluated mesh hides
+        # its ".corner_vert" attribute, whose block copy read_buffers needs.
+        data = evaluated.data if bpy.app.version < (4, 0, 0) else None
+        if n and data is not None and data.as_pointer() != obj.data.as_pointer() and len(data.vertices) == n:
+            yield data
+            return
         mesh = evaluated.to_mesh()
         try:
-            if len(mesh.vertices) == len(bmesh.from_edit_mesh(obj.data).verts):
+            if len(mesh.vertices) == n:
                 yield mesh
                 return
         finally:
@@ -147,6 +160,20 @@ def _edit_selection(obj):
         selected = [v.index for v in bm.verts if v.select]
     bm.verts.ensure_lookup_table()
     return selected, history, bm.verts
+
+
+def hold_edit_bmesh(obj):
+    """Keep obj's edit bmesh's Python handle alive while the result lives (None outside Edit Mode).
+
+    Blender gives an edit bmesh a layer that maps its elements to their Python objects when the
+    first of them is made, and removes it when the handle goes; each time, every vertex's data is
+    laid out anew (4 to 6 ms at 150k vertices in 3.4 once the mesh has weights). While this is
+    held, the read (the click order) and the write (the weights) share one handle: once, not
+    once each. If Blender frees the edit bmesh meanwhile (leaving Edit Mode, undo), the handle
+    just becomes invalid and the next bmesh.from_edit_mesh() makes a new one."""
+    if obj is None or getattr(obj, "type", None) != 'MESH' or obj.mode != 'EDIT':
+        return None
+    return bmesh.from_edit_mesh(obj.data)
 
 
 def _history_file_dirs():
@@ -308,12 +335,23 @@ def write_vertex_group(obj, name, indices):
     else:
         nv = len(obj.data.vertices)
         if nv and existed:
-            group.remove(list(range(nv)))
+            # Out go only the vertices that will not be in it: the ones that stay keep their weight
+            # record (REPLACE sets it to 1), where removing everyone first freed each record and
+            # add() allocated it again (a repeat Segment writes the same vertices again).
+            group.remove(_complement(nv, indices))
         if len(indices):
             group.add(list(indices), 1.0, 'REPLACE')
     if obj.vertex_groups.active_index != gi:
         obj.vertex_groups.active_index = gi
     return group
+
+
+def _complement(n, indices):
+    """The vertices 0..n-1 not in indices, ascending (itertools.compress: the scan runs in C)."""
+    outside = bytearray(b"\1") * n
+    for i in indices:
+        outside[i] = 0
+    return list(itertools.compress(range(n), outside))
 
 
 def _clear_active_group_in_edit_mode(obj):

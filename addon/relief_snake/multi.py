@@ -388,14 +388,30 @@ class MESH_OT_relief_snake_detect(_ModalRun, bpy.types.Operator):
     def _read(self, context):
         obj = context.active_object
         vertices, triangles = _read_mesh(obj)
-        return obj, vertices, triangles, lambda mesh, progress: _detect(mesh, progress=progress), 0
+        # Candidates above the background, once the engine says: written by the worker thread into a
+        # plain list (never into the operator, which may be gone by then).
+        found = self._found = [0]
+
+        def work(mesh, progress):
+            def counting(index, phase, iteration, snaxels, contour):
+                if phase == "candidates":
+                    found[0] = iteration
+                return progress(index, phase, iteration, snaxels, contour)
+            return _detect(mesh, progress=counting)
+        return obj, vertices, triangles, work, 0
 
     def _status_text(self, snap):
         if snap.stage in ("intake", "waiting"):
             return _phase_text(snap)
-        if snap.stage == "segment":  # the background fit and the components: no progress calls
+        if snap.stage == "segment":  # the engine's first call is a moment away
             return "finding candidates, %.0f s" % snap.seconds
-        return "candidate %d: %s" % (snap.index + 1, _phase_text(snap))
+        if snap.stage == "background":  # the engine fits up to three backgrounds (degrees 2, 4, 6)
+            return "finding candidates: fitting the background, %.0f s" % snap.seconds
+        if snap.stage == "candidates":
+            return "%d candidates above the background, %.0f s" % (snap.iteration, snap.seconds)
+        found = getattr(self, "_found", [0])[0]
+        of = " of %d" % found if found > snap.index else ""
+        return "candidate %d%s: %s" % (snap.index + 1, of, _phase_text(snap))
 
     def _finish(self, context, obj, doc):
         DETECTIONS[obj.name_full] = doc

@@ -10,6 +10,8 @@ cancel leaves the scene untouched. Every modal step runs under try/finally: what
 the timer, the draw handler and the status text go away when the run ends.
 """
 
+import time
+
 import bpy
 
 from . import api, job, modal_run, pick_order, preview, properties, region_view, summary, units
@@ -53,7 +55,6 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
 
     def _prepare(self, context):
         """Validate and read everything; raises api.EngineError. Writes nothing."""
-        import time
         obj = context.active_object
         api._mesh_object(obj)
         if not self.group_name.strip():
@@ -70,8 +71,24 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
         request.read_seconds = time.perf_counter() - t0  # selection + click order count as data transfer too
         return obj, request, info
 
+    def _hold_edit_bmesh(self, context):
+        """One edit bmesh handle for the read and the write (mesh_io.hold_edit_bmesh)."""
+        from . import mesh_io
+        self._held_bmesh = mesh_io.hold_edit_bmesh(context.active_object)
+
+    def _release_edit_bmesh(self, result):
+        """Drop the handle once the weights are written; Blender then removes the element layer,
+        which is part of writing: its time counts there."""
+        t0 = time.perf_counter()
+        self._held_bmesh = None
+        timing = result.setdefault("timing", {})
+        seconds = time.perf_counter() - t0
+        timing["write"] = timing.get("write", 0.0) + seconds
+        timing["total"] = timing.get("total", 0.0) + seconds
+
     def _finish(self, context, obj, result, info, request):
         api.apply_result(obj, result, group_name=self.group_name, make_curve=self.make_curve)
+        self._release_edit_bmesh(result)
         settings = _settings(context)
         details = summary.phase_lines(result) + [summary.timing_line(result)]
         h_line = summary.step_height_line(result, lambda v: units.format_length(context.scene, v))
@@ -99,6 +116,7 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
     # -- synchronous ------------------------------------------------------------------
     def execute(self, context):
         self._fill_from_scene(context)
+        self._hold_edit_bmesh(context)
         try:
             obj, request, info = self._prepare(context)
             result = api.run_engine(api.load_core(), request)
@@ -106,6 +124,8 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
         except api.EngineError as exc:
             self.report({'ERROR'}, str(exc))
             return {'CANCELLED'}
+        finally:
+            self._held_bmesh = None
 
     # -- interactive (modal_run.py) ---------------------------------------------------------
     def _set_current_run(self, op):
@@ -123,6 +143,7 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
         return self._begin_modal(context)
 
     def _start(self, context):
+        self._hold_edit_bmesh(context)  # until the write, or _cleanup
         obj, request, info = self._prepare(context)
         self._obj_name, self._info, self._request = obj.name, info, request
         self._job = job.SegmentJob(api.load_core(), request).start()

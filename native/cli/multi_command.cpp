@@ -233,8 +233,12 @@ int run_detect(const std::vector<std::string>& args, const MeshLoader& load) {
   std::size_t last = static_cast<std::size_t>(-1);
   GroupProgressCallback progress;
   if (!quiet)
-    progress = [&](std::size_t c, const Progress&) {
-      if (c != last) std::fprintf(stderr, "relief-snake: refining candidate %zu\n", c + 1), last = c;
+    progress = [&](std::size_t c, const Progress& p) {
+      const std::string phase = p.phase ? p.phase : "";
+      if (phase == "candidates")
+        std::fprintf(stderr, "relief-snake: %d candidates above the background\n", p.iteration);
+      else if (phase != "background" && c != last)
+        std::fprintf(stderr, "relief-snake: refining candidate %zu\n", c + 1), last = c;
       return true;
     };
   const DetectResult result = detect(segmenter, mesh, region, options, progress);

@@ -938,7 +938,9 @@ PYBIND11_MODULE(relief_snake_core, m) {
            "snake from its own outline (refine=False: the components only). Returns the 'relief-snake-detect/1'\n"
            "document (docs/result-format.md): candidates (each a result document plus 'detection': area,\n"
            "height, score, outline), overlaps, background, notes. progress(index, phase, iteration, snaxels,\n"
-           "contour): index is the candidate being refined.")
+           "contour) -> bool|None: phase 'background' before each background fit (iteration: fits done, index 0),\n"
+           "'candidates' once the components are known (iteration: how many), then the snake's phases with\n"
+           "index the candidate being refined; False raises Cancelled.")
       .def("measure", &PyMesh::measure, py::arg("i"), py::arg("j"),
            "measure(i, j) -> float: Euclidean distance between input vertices i and j.")
       .def("__repr__", [](const PyMesh& self) {

@@ -151,6 +151,25 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
                 " vertices on the surface, too few to fit a background; give a larger region");
   out.background.region_vertices = samples.size();
 
+  // Progress before the refinement, so front ends can show it and cancel there (on a large scan the
+  // fits and the components take about as long as refining a candidate): phase "background" before
+  // each fit (iteration: the fits done), then "candidates" once the components are known
+  // (iteration: how many). Index 0: no candidate is refined yet.
+  auto stage = [&](const char* phase, int iteration) {
+    if (!progress) return true;
+    Progress p;
+    p.phase = phase;
+    p.iteration = iteration;
+    p.contour = [] { return std::vector<Vec3>{}; };
+    return progress(0, p);
+  };
+  auto cancelled = [&] {
+    out.cancelled = true;
+    out.seconds = seconds_since(start);
+    return out;
+  };
+  if (!stage("background", 0)) return cancelled();
+
   // --- 1. robust background over the whole region --------------------------------------
   // auto: the lowest degree of 2, 4, 6 whose noise sigma is within 10% of the best (a plane or a
   // gentle curve keeps its quadric; a vase's changing radius needs the sixth degree).
@@ -168,6 +187,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
   } else {
     std::vector<RobustFit> fits;
     for (const int degree : {2, 4, 6}) {
+      if (!fits.empty() && !stage("background", static_cast<int>(fits.size()))) return cancelled();
       fit_options.degree = degree;
       fits.push_back(fit_robust_background(mesh, fit_samples, fit_options));
     }
@@ -266,6 +286,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
   std::vector<int> label(nv, -1);
   for (std::size_t c = 0; c < raw.size(); ++c)
     for (const int v : raw[c].vertices) label[v] = static_cast<int>(c);
+  if (!stage("candidates", static_cast<int>(raw.size()))) return cancelled();
 
   // --- 4. refine each candidate from its own outline --------------------------------------
   std::vector<DetectCandidate> candidates;

@@ -86,8 +86,8 @@ def _run_operator(api, obj, truth, label):
     transfer = t["read"] + t["write"]
     other = total - t["engine"] - transfer
     obj = bpy.data.objects["Scan"]
-    print("bench: %-12s %s total %.2f s = data transfer %.2f s (read %.2f, write %.2f; %.0f%% of the total) "
-          "+ engine %.2f s (mesh intake %.2f, segmentation %.2f; mesh %s) + other %.2f s; status %s"
+    print("bench: %-12s %s total %.3f s = data transfer %.3f s (read %.3f, write %.3f; %.0f%% of the total) "
+          "+ engine %.3f s (mesh intake %.3f, segmentation %.3f; mesh %s) + other %.3f s; status %s"
           % (label, ret, total, transfer, t["read"], t["write"], 100 * transfer / total, t["engine"], t["intake"],
              segmentation, "reused" if r["mesh_cached"] else "built", other, r.get("status")))
 

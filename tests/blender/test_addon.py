@@ -125,6 +125,48 @@ def group_members(obj, name):
     return out
 
 
+def group_weights(obj, name):
+    """{vertex index: weight} of the vertex group `name`, from the edit bmesh in Edit Mode."""
+    gi = obj.vertex_groups[name].index
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(obj.data)
+        layer = bm.verts.layers.deform.active
+        if layer is None:
+            return {}
+        return {v.index: round(v[layer][gi], 6) for v in bm.verts if gi in v[layer]}
+    return {v.index: round(g.weight, 6) for v in obj.data.vertices for g in v.groups if g.group == gi}
+
+
+def set_weights(obj, name, weights):
+    """Give vertices {index: weight} in group `name`, as painting would (Edit Mode: the edit bmesh)."""
+    gi = obj.vertex_groups[name].index
+    if obj.mode == 'EDIT':
+        bm = bmesh.from_edit_mesh(obj.data)
+        layer = bm.verts.layers.deform.verify()
+        bm.verts.ensure_lookup_table()
+        for i, w in weights.items():
+            bm.verts[i][layer][gi] = w
+        return
+    for i, w in weights.items():
+        obj.vertex_groups[name].add([i], w, 'REPLACE')
+
+
+def delete_vertices(obj, indices):
+    """Delete vertices (and their faces) as an edit would; the selection and its history follow."""
+    edit = obj.mode == 'EDIT'
+    bm = bmesh.from_edit_mesh(obj.data) if edit else bmesh.new()
+    if not edit:
+        bm.from_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    bmesh.ops.delete(bm, geom=[bm.verts[i] for i in indices], context='VERTS')
+    if edit:
+        bmesh.update_edit_mesh(obj.data)
+    else:
+        bm.to_mesh(obj.data)
+        bm.free()
+        obj.data.update()
+
+
 def iou(a, b):
     a, b = set(a), set(b)
     return len(a & b) / max(1, len(a | b))
@@ -259,14 +301,35 @@ class SegmentOperator(AddonTestCase):
         bpy.ops.object.mode_set(mode='OBJECT')
 
     def test_edit_mode_geometry_changes_are_seen(self):
+        # Every read after an edit, the first (through to_mesh) and the later ones (the depsgraph's
+        # mesh that to_mesh converted, read in place), gives the edit mesh as it is.
         bpy.ops.object.mode_set(mode='EDIT')
-        bm = bmesh.from_edit_mesh(self.obj.data)
-        bm.verts.ensure_lookup_table()
-        bm.verts[0].co.z += 123.0
-        bmesh.update_edit_mesh(self.obj.data)
         api = addon().api
-        request = api.prepare(self.obj, self.picks, self.h)
-        self.assertAlmostEqual(request.vertices[2], _CFG["vertices"][0][2] + 123.0, places=3)
+
+        def edit(vertex, dz):
+            bm = bmesh.from_edit_mesh(self.obj.data)
+            bm.verts.ensure_lookup_table()
+            bm.verts[vertex].co.z += dz
+            bmesh.update_edit_mesh(self.obj.data)
+
+        def evaluated_copy():
+            evaluated = self.obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+            mesh = evaluated.to_mesh()
+            try:
+                return addon().mesh_io.read_buffers(mesh)
+            finally:
+                evaluated.to_mesh_clear()
+        edit(0, 123.0)
+        for step in (None, (7, 5.0), None, (11, -2.0)):
+            if step:
+                edit(*step)
+            first = api.prepare(self.obj, self.picks, self.h)
+            again = api.prepare(self.obj, self.picks, self.h)
+            self.assertEqual(first.digest, again.digest)
+            self.assertEqual(first.digest, addon().job.fingerprint(*evaluated_copy()))
+            self.assertAlmostEqual(again.vertices[2], _CFG["vertices"][0][2] + 123.0, places=3)
+        self.assertAlmostEqual(again.vertices[3 * 7 + 2], _CFG["vertices"][7][2] + 5.0, places=3)
+        self.assertAlmostEqual(again.vertices[3 * 11 + 2], _CFG["vertices"][11][2] - 2.0, places=3)
         bpy.ops.object.mode_set(mode='OBJECT')
 
     def test_second_run_replaces_group_and_curve(self):
@@ -357,6 +420,81 @@ class SegmentOperator(AddonTestCase):
         self.assertEqual(seg(step_height=self.h), {'FINISHED'})
         bpy.ops.object.mode_set(mode='OBJECT')
         self.assertNotIn(3, group_members(self.obj, "Relief"))
+
+    def test_rewriting_a_group_leaves_exactly_the_new_vertices_at_weight_one(self):
+        # The group keeps its records for the vertices that stay (Object Mode removes only the
+        # others): what stays, what goes, what comes and a weight the user changed between runs.
+        io = addon().mesh_io
+        nv = len(self.obj.data.vertices)
+        other = self.obj.vertex_groups.new(name="Other")
+        other.add(list(range(0, nv, 5)), 0.25, 'REPLACE')
+        first, second = sorted(range(0, 300, 2)), sorted(range(150, 600, 3))
+        for mode in ('OBJECT', 'EDIT'):
+            bpy.ops.object.mode_set(mode=mode)
+            io.write_vertex_group(self.obj, "Relief", first)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(first, 1.0), mode)
+            io.write_vertex_group(self.obj, "Relief", second)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(second, 1.0), mode)
+            set_weights(self.obj, "Relief", {second[0]: 0.4, 1: 0.7})  # painted: a member, and an outsider
+            io.write_vertex_group(self.obj, "Relief", second)
+            self.assertEqual(group_weights(self.obj, "Relief"), dict.fromkeys(second, 1.0), mode)
+            io.write_vertex_group(self.obj, "Relief", [])
+            self.assertEqual(group_weights(self.obj, "Relief"), {}, mode)
+            self.assertEqual(group_weights(self.obj, "Other"), dict.fromkeys(range(0, nv, 5), 0.25), mode)
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertEqual([g.name for g in self.obj.vertex_groups], ["Other", "Relief"])
+
+    def _spy_engine(self):
+        """[(picks, result)] of every run_engine call the operator makes, until the test ends."""
+        api, calls = addon().api, []
+        real = api.run_engine
+
+        def spy(core, request, *args, **kwargs):
+            calls.append((list(request.picks), real(core, request, *args, **kwargs)))
+            return calls[-1][1]
+        api.run_engine = spy
+        self.addCleanup(setattr, api, "run_engine", real)
+        return calls
+
+    def test_each_run_uses_the_click_order_of_its_own_selection(self):
+        # The same vertices picked again in another order between two runs (the mesh unchanged,
+        # so the engine's mesh is reused): the second run segments from the new order.
+        calls = self._spy_engine()
+        for mode in ('OBJECT', 'EDIT'):
+            bpy.ops.object.mode_set(mode=mode)
+            for order in (self.picks, self.picks[5:] + self.picks[:5], self.picks[::-1]):
+                select_vertices(self.obj, order)
+                self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+                self.assertEqual(calls[-1][0], order, mode)
+        self.assertTrue(all(result["mesh_cached"] for _, result in calls[1:]))
+        bpy.ops.object.mode_set(mode='OBJECT')
+        self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_an_edit_between_runs_moves_the_group_with_the_vertices(self):
+        # Three corner vertices deleted between two runs: every later index shifts, the engine's
+        # cached mesh no longer fits (new fingerprint) and the group lands on the shifted vertices.
+        calls = self._spy_engine()
+        for mode in ('OBJECT', 'EDIT'):
+            clear_scene()
+            self.obj = make_scan_object()
+            bpy.ops.object.mode_set(mode=mode)
+            select_vertices(self.obj, self.picks)
+            self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+            first = calls[-1][1]["relief_vertices"]
+            gone = [0, 1, 2]  # a corner of the scan, far from the relief
+            delete_vertices(self.obj, gone)
+
+            def moved(i):
+                return i - sum(1 for g in gone if g < i)
+            self.assertEqual(seg(step_height=self.h), {'FINISHED'})
+            picks, result = calls[-1]
+            self.assertEqual(picks, [moved(i) for i in self.picks], mode)
+            self.assertFalse(result["mesh_cached"], mode)
+            bpy.ops.object.mode_set(mode='OBJECT')
+            members = group_members(self.obj, "Relief")
+            self.assertEqual(members, set(result["relief_vertices"]), mode)
+            self.assertGreaterEqual(iou(members, [moved(i) for i in first]), 0.99, mode)
+            self.assertGreaterEqual(iou(members, [moved(i) for i in self.truth["relief_vertices"]]), IOU_MIN, mode)
 
     def test_edit_mode_undo_and_redo(self):
         bpy.ops.object.mode_set(mode='EDIT')
@@ -986,7 +1124,7 @@ class ModalPath(AddonTestCase):
                 reports.append((set(kind), text))
 
         for name in ("modal", "_modal_step", "_start", "_prepare", "_finish", "_cleanup", "_status", "_current_run",
-                     "_set_current_run"):
+                     "_set_current_run", "_hold_edit_bmesh", "_release_edit_bmesh"):
             setattr(Stand_in, name, getattr(cls, name))
         op = Stand_in()
         s = bpy.context.scene.relief_snake
@@ -1024,6 +1162,32 @@ class ModalPath(AddonTestCase):
         self.assertIn(("progress_end",), recorder.calls)
         self.assertCleanedUp(cls, op, recorder)
         self.assertSegmentationMatchesTruth(self.obj)
+
+    def test_edit_mode_holds_one_bmesh_handle_from_the_read_to_the_write(self):
+        # The read and the write share one handle (mesh_io.hold_edit_bmesh), dropped once the
+        # weights are written; leaving Edit Mode while it is held (Blender frees the edit bmesh)
+        # only invalidates it, and the run still writes, now through the mesh data.
+        for leave in (False, True):
+            clear_scene()
+            self.obj = make_scan_object()
+            bpy.ops.object.mode_set(mode='EDIT')
+            select_vertices(self.obj, self.picks)
+            cls, op, reports = self.make_operator(step_height=self.h, estimate_step_height=False)
+            recorder = _Recorder()
+            context = _Context(recorder)
+            self.assertEqual(op.modal(context, _Event('TIMER')), {'RUNNING_MODAL'})  # read, worker started
+            self.assertIsNotNone(op._held_bmesh)
+            self.assertIs(bmesh.from_edit_mesh(self.obj.data), op._held_bmesh)
+            if leave:
+                bpy.ops.object.mode_set(mode='OBJECT')
+                self.assertFalse(op._held_bmesh.is_valid)
+            ret = self.tick_until_done(op, context)
+            self.assertEqual(ret, {'FINISHED'}, reports)
+            self.assertIsNone(op._held_bmesh)
+            self.assertCleanedUp(cls, op, recorder)
+            if not leave:
+                bpy.ops.object.mode_set(mode='OBJECT')
+            self.assertSegmentationMatchesTruth(self.obj)
 
     def test_esc_cancels_and_writes_nothing(self):
         select_vertices(self.obj, self.picks)
@@ -1263,6 +1427,34 @@ class SeveralReliefsModal(AddonTestCase):
         self.assertTrue(any(t and "candidate" in t and "Esc cancels" in t for t in recorder.statuses),
                         recorder.statuses)
         self.assertIn(({'INFO'}, "%d candidates found" % len(big)), reports)
+
+    def test_detect_reports_its_first_stages_and_counts_the_candidates(self):
+        # The engine calls progress while it fits the background and once it knows the candidates,
+        # before any refinement; the status bar says so, then "candidate k of n".
+        cls = addon().multi.MESH_OT_relief_snake_detect
+        op, _ = self.make_operator(cls)
+        obj, vertices, triangles, work, _total = op._read(_WindowContext(_WindowRecorder()))
+        calls = []
+        doc = work(addon().api.load_core().Mesh(vertices, triangles),
+                   lambda index, phase, iteration, snaxels, contour: calls.append((phase, iteration, index)) or True)
+        phases = [c[0] for c in calls]
+        self.assertEqual(phases[:4], ["background"] * 3 + ["candidates"], phases[:8])
+        self.assertNotIn("background", phases[4:])
+        found = calls[3][1]
+        self.assertGreaterEqual(found, len(doc["candidates"]))
+        self.assertEqual(op._found, [found])
+        self.assertEqual({c[2] for c in calls[4:]}, set(range(found)))  # each candidate refined after the count
+        Snapshot = addon().job.Snapshot
+        self.assertIn("fitting the background", op._status_text(Snapshot("background", 1, seconds=2.0)))
+        self.assertIn("%d candidates above the background" % found,
+                      op._status_text(Snapshot("candidates", found, seconds=2.0)))
+        self.assertIn("candidate 2 of %d: refining" % found, op._status_text(Snapshot("refine", 10, 40, index=1)))
+        # Cancelled while the background is fitted: the engine stops there, before any refinement.
+        calls.clear()
+        with self.assertRaises(addon().api.load_core().Cancelled):
+            work(addon().api.load_core().Mesh(vertices, triangles),
+                 lambda index, phase, iteration, snaxels, contour: calls.append(phase) or False)
+        self.assertEqual(calls, ["background"])
 
     def test_detect_esc_leaves_everything_as_it_was(self):
         items = bpy.context.scene.relief_snake_candidates

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "plate_scans.hpp"
 #include "relief_snake/detect.hpp"
@@ -233,4 +235,64 @@ TEST(Detect, RegionAndOptions) {
   EXPECT_THROW(rs::detect(segmenter, mesh, {}, bad), rs::Error);
   EXPECT_THROW(rs::detect(segmenter, mesh, {static_cast<std::int64_t>(plate.scan.n_vertices())}), rs::Error);
   EXPECT_THROW(rs::detect(segmenter, mesh, {0, 1, 2}), rs::Error);  // too few to fit
+}
+
+TEST(Detect, ReportsProgressBeforeRefiningAndCancelsThere) {
+  // The background fits and the components call progress too (front ends show them and can
+  // cancel there): "background" before each of the three fits, "candidates" with their count,
+  // and only then the snake's phases.
+  syn::PlateSpec spec;
+  spec.triangles = 40000;
+  spec.reliefs = {disk(-20, 0, 7, 1), disk(20, 0, 7, 1)};
+  const syn::PlateScan plate = syn::generate_plate(spec);
+  const rs::Mesh mesh = syn::to_mesh(plate.scan);
+  rs::Segmenter segmenter(mesh);
+  struct Call {
+    std::string phase;
+    int iteration;
+    std::size_t index;
+  };
+  std::vector<Call> calls;
+  std::size_t stop_after = 0;  // 0: never cancel
+  const rs::GroupProgressCallback progress = [&](std::size_t c, const rs::Progress& p) {
+    calls.push_back({p.phase, p.iteration, c});
+    if (calls.back().phase == "background" || calls.back().phase == "candidates") {
+      EXPECT_TRUE(p.contour().empty());  // callable, and nothing to draw yet
+    }
+    return stop_after == 0 || calls.size() < stop_after;
+  };
+  const rs::DetectResult result = rs::detect(segmenter, mesh, {}, {}, progress);
+  ASSERT_FALSE(result.cancelled);
+  ASSERT_EQ(result.candidates.size(), 2u);
+  ASSERT_GE(calls.size(), 5u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(calls[k].phase, "background");
+    EXPECT_EQ(calls[k].iteration, k);
+    EXPECT_EQ(calls[k].index, 0u);
+  }
+  EXPECT_EQ(calls[3].phase, "candidates");
+  EXPECT_EQ(calls[3].iteration, 2);
+  for (std::size_t k = 4; k < calls.size(); ++k) {
+    EXPECT_NE(calls[k].phase, "background");
+    EXPECT_NE(calls[k].phase, "candidates");
+  }
+  // Cancelled during the fits, and once the candidates are known: nothing is refined.
+  for (const std::size_t stop : {std::size_t{1}, std::size_t{2}, std::size_t{4}}) {
+    calls.clear();
+    stop_after = stop;
+    const rs::DetectResult cancelled = rs::detect(segmenter, mesh, {}, {}, progress);
+    EXPECT_TRUE(cancelled.cancelled) << stop;
+    EXPECT_TRUE(cancelled.candidates.empty()) << stop;
+    EXPECT_EQ(calls.size(), stop);
+  }
+  // A fixed degree: one fit, one "background" call.
+  calls.clear();
+  stop_after = 0;
+  rs::DetectOptions quadric;
+  quadric.background_degree = 2;
+  quadric.refine = false;
+  rs::detect(segmenter, mesh, {}, quadric, progress);
+  ASSERT_EQ(calls.size(), 2u);
+  EXPECT_EQ(calls[0].phase, "background");
+  EXPECT_EQ(calls[1].phase, "candidates");
 }

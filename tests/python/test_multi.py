@@ -263,6 +263,25 @@ def test_mesh_detect(disks):
     assert mesh.detect(min_area=10000.0, refine=False)["candidates"] == []
 
 
+def test_mesh_detect_progress_before_refining(disks):
+    """The background fits and the components call progress (phase 'background', then
+    'candidates' with their count) before the snake's phases; a cancel there stops at once."""
+    vertices, triangles, _, _ = disks
+    mesh = core.Mesh(vertices, triangles)
+    calls = []
+    doc = mesh.detect(progress=lambda i, phase, it, n, contour: calls.append((i, phase, it, contour)))
+    assert [c[1] for c in calls[:4]] == ["background"] * 3 + ["candidates"]
+    assert [c[2] for c in calls[:3]] == [0, 1, 2] and {c[0] for c in calls[:4]} == {0}
+    assert calls[3][2] >= len(doc["candidates"]) == 2
+    assert all(c[3] in (None, []) for c in calls[:4])  # nothing to draw yet
+    assert not {"background", "candidates"} & {c[1] for c in calls[4:]}
+    for stop in (1, 4):
+        seen = []
+        with pytest.raises(core.Cancelled):
+            mesh.detect(progress=lambda i, phase, it, n, contour: seen.append(phase) or len(seen) < stop)
+        assert len(seen) == stop and seen[-1] == ("background" if stop == 1 else "candidates")
+
+
 def test_mesh_detect_arguments(disks):
     vertices, triangles, _, _ = disks
     mesh = core.Mesh(vertices, triangles)

@@ -93,8 +93,10 @@ struct DetectResult {
 };
 
 /// region_vertices: input vertex indices to search (empty: the whole mesh). Throws Error on bad
-/// options or indices; a region without relief gives no candidates. progress(candidate, p): the
-/// snake's progress while candidate `candidate` is refined.
+/// options or indices; a region without relief gives no candidates. progress(candidate, p): first
+/// p.phase "background" before each background fit (p.iteration: the fits done; candidate 0), then
+/// "candidates" once the components are known (p.iteration: how many; candidate 0), then the
+/// snake's progress while candidate `candidate` is refined. Returning false cancels (cancelled set).
 DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<std::int64_t>& region_vertices,
                     const DetectOptions& options = {}, const GroupProgressCallback& progress = {});
 
