@@ -56,7 +56,6 @@ class ModalRun:
             wm.progress_end()
             self._progress_on = False
         preview.stop()
-        self._held_bmesh = None  # Segment's edit bmesh handle, if it holds one (mesh_io.hold_edit_bmesh)
         self._status(context, None)
         if self._current_run() is self:
             self._set_current_run(None)

@@ -76,6 +76,10 @@ class MESH_OT_relief_snake_segment(modal_run.ModalRun, bpy.types.Operator):
         from . import mesh_io
         self._held_bmesh = mesh_io.hold_edit_bmesh(context.active_object)
 
+    def _cleanup(self, context):
+        self._held_bmesh = None  # a run that ends before the write drops the handle here
+        modal_run.ModalRun._cleanup(self, context)  # (not super(): the tests run it on a stand-in)
+
     def _release_edit_bmesh(self, result):
         """Drop the handle once the weights are written; Blender then removes the element layer,
         which is part of writing: its time counts there."""

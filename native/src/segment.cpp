@@ -350,7 +350,6 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       }
       const int far_index = a.evidence.step.far_point;
       const Vec3 far_position = far_index >= 0 ? mesh.to_file(position(mesh, a.run.contour[far_index])) : Vec3::Zero();
-      a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       // The region-wide check only where the contour-wise one holds (a failing attempt is doubtful
       // already), and for the repair of a region that took in background.
       if (judge(a.evidence, h_try, contour_wise).holds) {
@@ -365,8 +364,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
         a.evidence.background_area = inside.area / (h_try * h_try);
         if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.to_file(mesh.position(inside.deepest_vertex));
         if (inside_out) *inside_out = std::move(inside);
-        a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
       }
+      a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
     };
     // Repair (closed contours; not in the paper): a region that took in a piece of background
     // (a bridged concavity, a lobe round a texture dot) loses it, and the snake is refined again
@@ -393,14 +392,14 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       return r;
     };
     bool first = true;
+    // A refinement from a coarse contour on the step whose contour shrinks well below the
+    // coarse-overlap check's share (its region could not pass min_coarse_iou; 0.8 leaves room for
+    // vector areas against region areas) is crossing the relief: stop it there.
+    const double abandon_share = coarse_step_share >= self_check.min_step_share ? 0.8 * self_check.min_coarse_iou : 0.0;
     for (const double w : w_steps) {
       Attempt a;
       a.h = h_try;
       a.w_int = w;
-      // A refinement from a coarse contour on the step whose contour shrinks well below the
-      // coarse-overlap check's share (its region could not pass min_coarse_iou; 0.8 leaves room for
-      // vector areas against region areas) is crossing the relief: stop it there.
-      const double abandon_share = coarse_step_share >= self_check.min_step_share ? 0.8 * self_check.min_coarse_iou : 0.0;
       a.run = schedule.refine(w, progress, abandon_share);
       a.parameters = schedule.parameters(w);
       ++result.attempts;

@@ -112,12 +112,12 @@ struct ContourEvidence {
   double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
   double area_ratio = 1;        ///< closed contours: the region's vector area against the contour's (1: they agree)
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
-  /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
-  /// depth and area, and the floor under the depth threshold (two average edges, in h).
   /// The refinement was abandoned with the contour enclosing this share of the coarse contour's
   /// area (ScheduleRun::abandoned; -1: it was not).
   double abandoned_area_share = -1;
   bool region_checked = false;  ///< the region-wide check ran and could measure the region
+  /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
+  /// depth and area, and the floor under the depth threshold (two average edges, in h).
   bool background_measured = false;
   double background_depth = 0, background_area = 0, background_depth_floor = 0;
   Vec3 background_where = Vec3::Zero();  ///< the deepest point of that piece (the file's coordinates)
