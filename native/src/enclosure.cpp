@@ -1,6 +1,7 @@
 // Does the picked contour enclose a relief: heights inside above the background along it (enclosure.hpp).
 #include "relief_snake/enclosure.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -33,6 +34,18 @@ double risen_area(const Enclosure& enclosure, double rise) {
   for (const WeightedHeight& v : enclosure.heights)
     if (v.height >= rise) area += v.weight;
   return area;
+}
+
+double covered_share(const Mesh& mesh, const Enclosure& enclosure, const std::vector<char>& region, double h,
+                     double step_found, const EnclosureOptions& options) {
+  const double judged = step_found > 0 ? std::min(h, step_found) : h;
+  if (!(judged > 0) || enclosure.heights.empty()) return -1;
+  const double risen = risen_area(enclosure, options.rise * judged);
+  if (risen < options.min_area * judged * judged && risen < options.min_share * enclosure.enclosed_area) return -1;
+  double area = 0;
+  for (int v = 0; v < mesh.n_vertices(); ++v)
+    if (region[v]) area += mesh.vertex_area(v);
+  return area / risen;
 }
 
 std::string enclosure_reason(const Enclosure& enclosure, double h, const EnclosureOptions& options) {

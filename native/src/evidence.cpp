@@ -297,6 +297,11 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
                             number(all.background_where[2]) +
                             ") lies at the background's height: the contour bridges a concavity there, or "
                             "wraps a lobe of background");
+  if (all.covered_share >= 0 && all.covered_share < options.min_covered_share)
+    check.reasons.push_back("the region covers only " +
+                            (all.covered_share < 0.005 ? std::string("under 1%") : percent(all.covered_share)) +
+                            " of the surface the picks enclose that stands half a step above the background: the "
+                            "snake may have settled on detail or texture inside the relief");
   if (evidence.step_share >= options.min_step_share && evidence.foot_share < options.min_foot_share)
     check.reasons.push_back("only " + percent(evidence.foot_share) +
                             " of the contour sits at the foot of the step; the rest runs partway up it");

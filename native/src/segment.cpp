@@ -327,6 +327,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       }
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
       a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
+      a.evidence.covered_share = covered_share(mesh, enclosure, a.region, h_try, a.evidence.step.step_height);
       a.evidence.coarse_step_share = coarse_step_share;
       a.evidence.abandoned_area_share = a.run.abandoned ? a.run.abandoned_area_share : -1.0;
       a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
@@ -540,6 +541,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     const double risen = risen_area(enclosure, EnclosureOptions().rise * judged);
     result.checks.push_back({"enclosed_risen_area", risen / (judged * judged)});
     result.checks.push_back({"enclosed_risen_share", enclosure.enclosed_area > 0 ? risen / enclosure.enclosed_area : 0.0});
+    result.checks.push_back({"covered_share", best.evidence.covered_share});
     result.checks.push_back({"enclosed_background_residual", enclosure.background_residual / best.h});
     // Named when nothing else is wrong (a snake holding on texture or noise inside picks beside the
     // relief), or when the snake found little step either; a contour mostly on a step with picks

@@ -176,6 +176,17 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   e.background_depth_floor = 0;
   e.background_depth = 0.5;
   EXPECT_TRUE(judge(e, 1.0).holds);
+  // The region against the risen area the picks enclose: judged only when measured (>= 0).
+  e.covered_share = 0.05;
+  c = judge(e, 1.0);
+  ASSERT_EQ(c.reasons.size(), 1u);
+  EXPECT_NE(c.reasons.front().find("covers only 5%"), std::string::npos);
+  e.covered_share = 0.001;
+  EXPECT_NE(judge(e, 1.0).reasons.front().find("under 1%"), std::string::npos);
+  e.covered_share = 0.6;
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.covered_share = -1;
+  EXPECT_TRUE(judge(e, 1.0).holds);
 }
 
 TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {

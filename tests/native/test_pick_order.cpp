@@ -200,4 +200,19 @@ TEST(PickOrder, EnclosureSeesTheReliefOnlyWhenEnclosed) {
   // the h it ended with, after the refit to the step it found).
   EXPECT_NE(rs::enclosure_reason(around, 3.0).find(kNoRelief), std::string::npos);
 
+  // A result's coverage of that risen area: the true disk covers it all (its wall's vertex areas
+  // too), a patch of it a share, and nothing risen inside the picks leaves it unmeasured.
+  std::vector<char> disk(mesh.n_vertices(), 0), patch(mesh.n_vertices(), 0);
+  for (int v = 0; v < mesh.n_vertices(); ++v) {
+    const rs::Vec3 p = mesh.position(v);
+    disk[v] = std::hypot(p[0], p[1]) < 12;
+    patch[v] = std::hypot(p[0] - 4, p[1]) < 3;
+  }
+  EXPECT_NEAR(rs::covered_share(mesh, around, disk, 1.0, 0), 1.0, 0.1);
+  EXPECT_NEAR(rs::covered_share(mesh, around, patch, 1.0, 0), 9.0 / 144, 0.02);
+  // Judged at the lower of h and the step found: with h = 3 typed, the step of 1 found still counts.
+  EXPECT_NEAR(rs::covered_share(mesh, around, disk, 3.0, 1.0), 1.0, 0.1);
+  EXPECT_EQ(rs::covered_share(mesh, around, disk, 3.0, 0), -1.0);
+  EXPECT_EQ(rs::covered_share(mesh, beside, patch, 1.0, 0), -1.0);
+
 }

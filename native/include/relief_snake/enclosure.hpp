@@ -45,4 +45,10 @@ double risen_area(const Enclosure& enclosure, double rise);
 /// lower): the reason (one sentence, for Result::reasons) when the picks enclose no relief, or "".
 std::string enclosure_reason(const Enclosure& enclosure, double h, const EnclosureOptions& options = {});
 
+/// A result's region (#V flags) against the enclosed area standing rise x (the lower of h and
+/// step_found, when that is > 0) above the background: its area over that area. -1 when nothing
+/// measurable rises (enclosure_reason's case, or an open contour's empty enclosure).
+double covered_share(const Mesh& mesh, const Enclosure& enclosure, const std::vector<char>& region, double h,
+                     double step_found, const EnclosureOptions& options = {});
+
 }  // namespace relief_snake
