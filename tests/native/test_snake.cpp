@@ -209,3 +209,25 @@ TEST(Snake, NearestResamplingKeepsNewSnaxelsOffAOneTriangleWall) {
   EXPECT_GT(walk_top, 0.3);  // the failure the nearest point avoids
   for (const SurfacePoint& p : surface_between(mesh, a, b, fractions, true)) EXPECT_LT(position(mesh, p).z(), 0.1);
 }
+
+TEST(Snake, ACutLoopMakesTheNextIterationLookAtEverySnaxel) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  std::vector<SurfacePoint> pts = circle(mesh, Vec3(10, 10, 0), 5, 24);
+  std::swap(pts[6], pts[7]);
+  Snake snake(mesh, pts, true, true);
+  std::vector<char> moved;
+  snake.take_moved_flags(&moved);
+  EXPECT_FALSE(snake.take_moved_flags(&moved));  // nothing cut yet
+  ASSERT_GE(snake.remove_loops(), 1);
+  EXPECT_TRUE(snake.take_moved_flags(&moved));  // once after the cut
+  EXPECT_FALSE(snake.take_moved_flags(&moved));
+  // The flags themselves: only the two ends of the new segment (the greedy step decides which
+  // other snaxels it must look at, evolution.cpp).
+  Snake cut(mesh, pts, true, true);
+  cut.take_moved_flags(&moved);
+  ASSERT_GE(cut.remove_loops(), 1);
+  cut.take_moved_flags(&moved);
+  int flagged = 0;
+  for (const char m : moved) flagged += m;
+  EXPECT_EQ(flagged, 2);
+}
