@@ -115,6 +115,9 @@ struct ContourEvidence {
   /// The refinement was abandoned with the contour enclosing this share of the coarse contour's
   /// area (ScheduleRun::abandoned; -1: it was not).
   double abandoned_area_share = -1;
+  /// The refinement was abandoned having left this share of the coarse contour's step
+  /// (RefineStop::max_left_share; -1: it was not).
+  double abandoned_left_share = -1;
   bool region_checked = false;  ///< the region-wide check ran and could measure the region
   /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
   /// depth and area, and the floor under the depth threshold (two average edges, in h).
