@@ -385,6 +385,8 @@ int Snake::remove_loops() {
   int removed = 0;
   std::vector<int> dirty, near;
   std::vector<std::pair<std::uint64_t, int>> keyed;
+  std::vector<Vec3> lo, hi, normals;
+  std::vector<char> has_normal;
   HashGrid grid;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
@@ -403,10 +405,22 @@ int Snake::remove_loops() {
     // the longest segment apart: in a hash grid of that cell size, each segment goes
     // into its midpoint's cell and a changed one looks at the 27 cells around its own.
     const double margin = 0.5 * longest, cell = 2 * longest;
-    auto box = [&](int i, Vec3* lo, Vec3* hi) {
+    // Every segment's box (tested many times) and, on first use, the normal at its first snaxel.
+    lo.resize(segments);
+    hi.resize(segments);
+    for (int i = 0; i < segments; ++i) {
       const Vec3 &p0 = snaxels_[i].position, &p1 = snaxels_[next(i)].position;
-      *lo = p0.cwiseMin(p1) - Vec3::Constant(margin);
-      *hi = p0.cwiseMax(p1) + Vec3::Constant(margin);
+      lo[i] = p0.cwiseMin(p1) - Vec3::Constant(margin);
+      hi[i] = p0.cwiseMax(p1) + Vec3::Constant(margin);
+    }
+    normals.resize(segments);
+    has_normal.assign(segments, 0);
+    auto normal_at = [&](int i) -> const Vec3& {
+      if (!has_normal[i]) {
+        normals[i] = normal(mesh_, snaxels_[i].point);
+        has_normal[i] = 1;
+      }
+      return normals[i];
     };
     grid.reset(snaxels_[0].position, cell);
     auto cell_of = [&](int i) { return grid.cell_of(0.5 * (snaxels_[i].position + snaxels_[next(i)].position)); };
@@ -431,17 +445,14 @@ int Snake::remove_loops() {
           for (int z = -1; z <= 1; ++z) grid.for_each(c + HashGrid::Cell(x, y, z), [&](int o) { near.push_back(o); });
       for (; g < g_end; ++g) {
         const int d = keyed[g].second;
-        Vec3 dlo, dhi;
-        box(d, &dlo, &dhi);
+        const Vec3 &dlo = lo[d], &dhi = hi[d];
         for (const int other : near) {
           const int a = std::min(d, other), b = std::max(d, other);
           if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) continue;  // neighbours share a snaxel
           if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) continue;
-          Vec3 olo, ohi;
-          box(other, &olo, &ohi);
-          if ((olo.array() > dhi.array()).any() || (dlo.array() > ohi.array()).any()) continue;
+          if ((lo[other].array() > dhi.array()).any() || (dlo.array() > hi[other].array()).any()) continue;
           if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
-                             snaxels_[next(b)].position, normal(mesh_, snaxels_[a].point))) {
+                             snaxels_[next(b)].position, normal_at(a))) {
             cut_a = a;
             cut_b = b;
           }

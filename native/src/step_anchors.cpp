@@ -32,20 +32,22 @@ StepLeft step_left(const StepAnchors& anchors, const Snake& snake, double distan
   const int m = static_cast<int>(anchors.points.size());
   const int on = anchors.on_step_count();
   if (m == 0 || on == 0 || snake.size() == 0 || !(distance > 0)) return out;
+  // The snaxels in a grid of cells `distance` wide; each on-step anchor looks at the 27 cells
+  // around its own until one is close enough (a few hundred anchors against thousands of snaxels).
   HashGrid grid(anchors.points[0], distance);
-  for (int k = 0; k < m; ++k)
-    if (anchors.on_step[k]) grid.add(grid.cell_of(anchors.points[k]), k);
+  for (int i = 0; i < snake.size(); ++i) grid.add(grid.cell_of(snake[i].position), i);
   grid.build();
   std::vector<char> reached(m, 0);
   const double d2 = distance * distance;
-  for (int i = 0; i < snake.size(); ++i) {
-    const Vec3& p = snake[i].position;
-    const HashGrid::Cell c = grid.cell_of(p);
-    for (int x = -1; x <= 1; ++x)
-      for (int y = -1; y <= 1; ++y)
-        for (int z = -1; z <= 1; ++z)
-          grid.for_each(c + HashGrid::Cell(x, y, z), [&](int k) {
-            if (!reached[k] && (anchors.points[k] - p).squaredNorm() <= d2) reached[k] = 1;
+  for (int k = 0; k < m; ++k) {
+    if (!anchors.on_step[k]) continue;
+    const Vec3& a = anchors.points[k];
+    const HashGrid::Cell c = grid.cell_of(a);
+    for (int x = -1; x <= 1 && !reached[k]; ++x)
+      for (int y = -1; y <= 1 && !reached[k]; ++y)
+        for (int z = -1; z <= 1 && !reached[k]; ++z)
+          grid.for_each(c + HashGrid::Cell(x, y, z), [&](int i) {
+            if ((snake[i].position - a).squaredNorm() <= d2) reached[k] = 1;
           });
   }
   int left = 0;
