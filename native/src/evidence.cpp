@@ -315,6 +315,10 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("the refinement was stopped when the contour enclosed only " +
                             percent(all.abandoned_area_share) +
                             " of the area the coarse contour found: it was crossing the relief");
+  if (all.abandoned_left_share >= 0)
+    check.reasons.push_back("the refinement was stopped when the contour had moved more than 2 h away from " +
+                            percent(all.abandoned_left_share) +
+                            " of the step the coarse contour found: it was crossing the relief");
   if (all.area_ratio > options.max_area_ratio || all.area_ratio * options.max_area_ratio < 1)
     check.reasons.push_back("the relief region covers " + number(all.area_ratio) +
                             " times the area the contour encloses: the region leaked past the contour or lost a "

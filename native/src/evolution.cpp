@@ -73,12 +73,18 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
   GreedyWorkspace& w = *workspace;
   const Mesh& mesh = snake.mesh();
   const int n = snake.size();
-  snake.take_moved_flags(&w.moved_before);
+  // After a loop was cut, every snaxel is looked at again (the cut shifts the colour classes).
+  // One whose flags are clear and none of whose neighbours moved earlier in this iteration has the
+  // position and neighbours it had when it last decided to stay: it would stay again, so it is
+  // skipped (the moves, and so the result, are those of looking at it; an iteration after a cut
+  // used to cost a full pass of walks).
+  const bool revisit = snake.take_moved_flags(&w.moved_before);
   auto evaluated = [&](int i) {
     // If it and its neighbours stood still last time, its energies are unchanged.
     const int ip = snake.prev(i), in = snake.next(i);
-    return !snake[i].locked &&
-           (w.moved_before[i] || (ip >= 0 && w.moved_before[ip]) || (in >= 0 && w.moved_before[in]));
+    if (snake[i].locked) return false;
+    if (w.moved_before[i] || (ip >= 0 && w.moved_before[ip]) || (in >= 0 && w.moved_before[in])) return true;
+    return revisit && ((ip >= 0 && snake[ip].moved) || (in >= 0 && snake[in].moved));
   };
   const bool use_feature = phase.w_f != 0 && phase.gamma != 0;
 

@@ -109,11 +109,11 @@ const ScheduleRun& EvolutionSchedule::coarse(const ProgressCallback& progress) {
   return run;
 }
 
-ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& progress, double min_area_share) {
+ScheduleRun EvolutionSchedule::refine(double w_int, const ProgressCallback& progress, const RefineStop& stop) {
   const ScheduleRun& first = coarse(progress);
   if (first.cancelled || first.collapsed) return first;
   // each refinement starts from the coarse snake
-  return refine_snake(*coarse_snake_, true, w_int, progress, min_area_share);
+  return refine_snake(*coarse_snake_, true, w_int, progress, stop);
 }
 
 ScheduleRun EvolutionSchedule::refine_from(const std::vector<SurfacePoint>& start, double w_int,
@@ -126,7 +126,7 @@ ScheduleRun EvolutionSchedule::refine_from(const std::vector<SurfacePoint>& star
 }
 
 ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels, double w_int,
-                                            const ProgressCallback& progress, double min_area_share) {
+                                            const ProgressCallback& progress, const RefineStop& stop) {
   ScheduleRun run = coarse_run_;
   const DerivedParameters param = parameters(w_int);
 
@@ -146,10 +146,16 @@ ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels,
   refine.gamma_sigma2 = 0;
   refine = at_spacing(refine, param.refine_spacing);
 
-  const double coarse_area = min_area_share > 0 && options_.closed ? vector_area(start.polyline()).norm() : 0.0;
+  const double coarse_area = stop.min_area_share > 0 && options_.closed ? vector_area(start.polyline()).norm() : 0.0;
   const auto area_share = [coarse_area](const Snake& s) { return vector_area(s.polyline()).norm() / coarse_area; };
-  if (coarse_area > 0)
-    refine.abandon = [&area_share, min_area_share](const Snake& s) { return area_share(s) < min_area_share; };
+  const StepAnchors* anchors = options_.closed && stop.anchors && stop.anchors->on_step_count() > 0 ? stop.anchors : nullptr;
+  const double left_distance = stop.left_distance * h_;
+  bool for_area = false;
+  if (coarse_area > 0 || anchors)
+    refine.abandon = [&](const Snake& s) {
+      for_area = coarse_area > 0 && area_share(s) < stop.min_area_share;
+      return for_area || (anchors && step_left(*anchors, s, left_distance).share > stop.max_left_share);
+    };
 
   PhaseSettings stabilise = refine;
   stabilise.name = "stabilise";
@@ -202,7 +208,9 @@ ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels,
         stats.seconds = seconds_since(t_phase);
         run.phases.push_back(stats);
         run.abandoned = true;
-        run.abandoned_area_share = area_share(snake);
+        run.abandoned_for_area = for_area;
+        run.abandoned_area_share = coarse_area > 0 ? area_share(snake) : 0.0;
+        if (anchors) run.abandoned_left_share = step_left(*anchors, snake, left_distance).share;
         run.contour = snake.points();
         return run;
       }

@@ -168,12 +168,15 @@ void Snake::move(int i, const SurfacePoint& p) {
   snaxels_[i].stamp = ++version_;
 }
 
-void Snake::take_moved_flags(std::vector<char>* moved_before) {
+bool Snake::take_moved_flags(std::vector<char>* moved_before) {
   moved_before->resize(snaxels_.size());
   for (std::size_t i = 0; i < snaxels_.size(); ++i) {
     (*moved_before)[i] = snaxels_[i].moved;
     snaxels_[i].moved = false;
   }
+  const bool revisit = revisit_all_;
+  revisit_all_ = false;
+  return revisit;
 }
 
 void Snake::step(int i, const SurfacePoint& p) {
@@ -380,7 +383,10 @@ int Snake::remove_loops() {
   const std::uint64_t since = loops_checked_;
   loops_checked_ = version_;
   int removed = 0;
-  std::vector<int> dirty;
+  std::vector<int> dirty, near;
+  std::vector<std::pair<std::uint64_t, int>> keyed;
+  std::vector<Vec3> lo, hi, normals;
+  std::vector<char> has_normal;
   HashGrid grid;
   for (int pass = 0; pass < 64; ++pass) {
     const int n = size();
@@ -399,39 +405,59 @@ int Snake::remove_loops() {
     // the longest segment apart: in a hash grid of that cell size, each segment goes
     // into its midpoint's cell and a changed one looks at the 27 cells around its own.
     const double margin = 0.5 * longest, cell = 2 * longest;
-    auto box = [&](int i, Vec3* lo, Vec3* hi) {
+    // Every segment's box (tested many times) and, on first use, the normal at its first snaxel.
+    lo.resize(segments);
+    hi.resize(segments);
+    for (int i = 0; i < segments; ++i) {
       const Vec3 &p0 = snaxels_[i].position, &p1 = snaxels_[next(i)].position;
-      *lo = p0.cwiseMin(p1) - Vec3::Constant(margin);
-      *hi = p0.cwiseMax(p1) + Vec3::Constant(margin);
+      lo[i] = p0.cwiseMin(p1) - Vec3::Constant(margin);
+      hi[i] = p0.cwiseMax(p1) + Vec3::Constant(margin);
+    }
+    normals.resize(segments);
+    has_normal.assign(segments, 0);
+    auto normal_at = [&](int i) -> const Vec3& {
+      if (!has_normal[i]) {
+        normals[i] = normal(mesh_, snaxels_[i].point);
+        has_normal[i] = 1;
+      }
+      return normals[i];
     };
     grid.reset(snaxels_[0].position, cell);
     auto cell_of = [&](int i) { return grid.cell_of(0.5 * (snaxels_[i].position + snaxels_[next(i)].position)); };
     for (int i = 0; i < segments; ++i) grid.add(cell_of(i), i);
     grid.build();
-    auto for_near = [&](int d, const auto& visit) {
-      const HashGrid::Cell c = cell_of(d);
+    // The changed segments grouped by their cell's key (neighbours along the snake share cells):
+    // each group gathers the segments of its 27 cells once. (Cells whose keys agree have
+    // neighbourhoods whose keys agree, so each changed segment sees what it would alone.)
+    keyed.clear();
+    for (const int d : dirty) keyed.emplace_back(HashGrid::key(cell_of(d)), d);
+    std::sort(keyed.begin(), keyed.end());
+    // The crossing with the smallest first segment (then second), as a scan along the snake would
+    // find: the smallest crossing pair among those tested, in whatever order they are tested.
+    int cut_a = -1, cut_b = -1;
+    for (std::size_t g = 0; g < keyed.size();) {
+      std::size_t g_end = g;
+      while (g_end < keyed.size() && keyed[g_end].first == keyed[g].first) ++g_end;
+      near.clear();
+      const HashGrid::Cell c = cell_of(keyed[g].second);
       for (int x = -1; x <= 1; ++x)
         for (int y = -1; y <= 1; ++y)
-          for (int z = -1; z <= 1; ++z) grid.for_each(c + HashGrid::Cell(x, y, z), visit);
-    };
-    // The crossing with the smallest first segment (then second), as a scan along the snake would find.
-    int cut_a = -1, cut_b = -1;
-    for (int d : dirty) {
-      Vec3 dlo, dhi;
-      box(d, &dlo, &dhi);
-      for_near(d, [&](int other) {
-        const int a = std::min(d, other), b = std::max(d, other);
-        if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) return;  // neighbours share a snaxel
-        if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) return;
-        Vec3 olo, ohi;
-        box(other, &olo, &ohi);
-        if ((olo.array() > dhi.array()).any() || (dlo.array() > ohi.array()).any()) return;
-        if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
-                           snaxels_[next(b)].position, normal(mesh_, snaxels_[a].point))) {
-          cut_a = a;
-          cut_b = b;
+          for (int z = -1; z <= 1; ++z) grid.for_each(c + HashGrid::Cell(x, y, z), [&](int o) { near.push_back(o); });
+      for (; g < g_end; ++g) {
+        const int d = keyed[g].second;
+        const Vec3 &dlo = lo[d], &dhi = hi[d];
+        for (const int other : near) {
+          const int a = std::min(d, other), b = std::max(d, other);
+          if (b <= a + 1 || (closed_ && a == 0 && b == segments - 1)) continue;  // neighbours share a snaxel
+          if (cut_a >= 0 && (a > cut_a || (a == cut_a && b >= cut_b))) continue;
+          if ((lo[other].array() > dhi.array()).any() || (dlo.array() > hi[other].array()).any()) continue;
+          if (segments_cross(snaxels_[a].position, snaxels_[next(a)].position, snaxels_[b].position,
+                             snaxels_[next(b)].position, normal_at(a))) {
+            cut_a = a;
+            cut_b = b;
+          }
         }
-      });
+      }
     }
     if (cut_a < 0) break;
     // Segments a and b cross: the loop is snaxels a+1 .. b (inner arc) or the
@@ -460,7 +486,7 @@ int Snake::remove_loops() {
     const int joint = keep_outer ? cut_a : static_cast<int>(snaxels_.size()) - 1;
     touch(joint);
     if (next(joint) >= 0) touch(next(joint));
-    for (Snaxel& s : snaxels_) s.moved = true;
+    revisit_all_ = true;
   }
   return removed;
 }
@@ -479,6 +505,7 @@ void Snake::subdivide(double l) {
 }
 
 void Snake::reset_state() {
+  revisit_all_ = false;  // every snaxel is flagged anyway
   for (Snaxel& s : snaxels_) {
     s.moved = true;
     s.locked = false;

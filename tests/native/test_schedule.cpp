@@ -1,10 +1,12 @@
 // The evolution schedule (schedule.hpp): refinements from the coarse snake, and the early stop
-// of a refinement whose contour shrinks away from the coarse one (it is crossing the relief).
+// of a refinement whose contour shrinks away from the coarse one, or leaves the step the coarse one
+// sat on (it is crossing the relief).
 #include <gtest/gtest.h>
 
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/planarity.hpp"
+#include "relief_snake/region.hpp"
 #include "relief_snake/schedule.hpp"
 #include "synthetic.hpp"
 
@@ -50,6 +52,12 @@ double enclosed(const Mesh& mesh, const std::vector<SurfacePoint>& contour) {
   return vector_area(line).norm();
 }
 
+RefineStop area_stop(double share) {
+  RefineStop stop;
+  stop.min_area_share = share;
+  return stop;
+}
+
 }  // namespace
 
 TEST(Schedule, ARefinementThatKeepsItsAreaRunsToTheEnd) {
@@ -57,7 +65,7 @@ TEST(Schedule, ARefinementThatKeepsItsAreaRunsToTheEnd) {
   const ScheduleRun& coarse = d.schedule->coarse(nullptr);
   ASSERT_FALSE(coarse.collapsed);
   // The disk's contour keeps its area through refinement: half the coarse area never stops it.
-  const ScheduleRun run = d.schedule->refine(0.25, nullptr, 0.5);
+  const ScheduleRun run = d.schedule->refine(0.25, nullptr, area_stop(0.5));
   EXPECT_FALSE(run.abandoned);
   ASSERT_FALSE(run.phases.empty());
   EXPECT_EQ(run.phases.back().name, "stabilise");
@@ -70,7 +78,7 @@ TEST(Schedule, ARefinementBelowItsAreaShareIsAbandoned) {
   ASSERT_FALSE(coarse.collapsed);
   // A share no contour on this relief can reach (twice the coarse area) stops the refinement at
   // its first look: no stabilisation, the contour where it was, the share it had.
-  const ScheduleRun run = d.schedule->refine(0.25, nullptr, 2.0);
+  const ScheduleRun run = d.schedule->refine(0.25, nullptr, area_stop(2.0));
   ASSERT_TRUE(run.abandoned);
   EXPECT_FALSE(run.hit_cap);
   ASSERT_FALSE(run.phases.empty());
@@ -92,4 +100,60 @@ TEST(Schedule, ARefinementBelowItsAreaShareIsAbandoned) {
   ASSERT_FALSE(check.holds);
   ASSERT_EQ(check.reasons.size(), 1u);
   EXPECT_NE(check.reasons.front().find("refinement was stopped"), std::string::npos);
+}
+
+TEST(Schedule, ARefinementThatKeepsToTheCoarseStepRunsToTheEnd) {
+  DiskSchedule d;
+  const ScheduleRun& coarse = d.schedule->coarse(nullptr);
+  ASSERT_FALSE(coarse.collapsed);
+  // The coarse contour's measured points on the disk's step, as segment() gives them: the
+  // refinement settles on the same step and never leaves a tenth of them behind.
+  const std::vector<char> region = relief_region(d.mesh, coarse.contour, true, true);
+  const StepEvidence evidence = measure_step(d.mesh, coarse.contour, region, d.scan.h);
+  const StepAnchors anchors = step_anchors(d.mesh, coarse.contour, evidence, true);
+  ASSERT_GT(anchors.on_step_count(), 10);
+  RefineStop stop;
+  stop.anchors = &anchors;
+  const ScheduleRun run = d.schedule->refine(0.25, nullptr, stop);
+  EXPECT_FALSE(run.abandoned);
+  ASSERT_FALSE(run.phases.empty());
+  EXPECT_EQ(run.phases.back().name, "stabilise");
+  EXPECT_LE(step_left(anchors, *run.snake, 2 * d.scan.h).share, 0.02);
+}
+
+TEST(Schedule, ARefinementThatLeavesTheCoarseStepIsAbandoned) {
+  DiskSchedule d;
+  const ScheduleRun& coarse = d.schedule->coarse(nullptr);
+  ASSERT_FALSE(coarse.collapsed);
+  // Anchors on a step no contour on this disk comes near (the coarse points lifted 10 h off the
+  // plate), a fifth of them on it: left at the first look.
+  StepAnchors anchors;
+  for (std::size_t k = 0; k < coarse.contour.size(); ++k) {
+    anchors.points.push_back(position(d.mesh, coarse.contour[k]) + Vec3(0, 0, 10 * d.scan.h));
+    anchors.on_step.push_back(k % 5 == 0);
+  }
+  anchors.spacing = d.scan.h;
+  RefineStop stop;
+  stop.anchors = &anchors;
+  const ScheduleRun run = d.schedule->refine(0.25, nullptr, stop);
+  ASSERT_TRUE(run.abandoned);
+  EXPECT_FALSE(run.abandoned_for_area);
+  EXPECT_DOUBLE_EQ(run.abandoned_left_share, 1.0);
+  EXPECT_LE(run.phases.back().iterations, 10);
+  // Only the on-step anchors count: with none of them on a step nothing stops it.
+  for (char& on : anchors.on_step) on = 0;
+  const ScheduleRun kept = d.schedule->refine(0.25, nullptr, stop);
+  EXPECT_FALSE(kept.abandoned);
+  // The self-check names it.
+  ContourEvidence e;
+  e.step.attempted = 10;
+  e.step.profiles.resize(10);
+  e.step.step_share = 1.0;
+  e.step.step_height = d.scan.h;
+  e.abandoned_left_share = run.abandoned_left_share;
+  const SelfCheck check = judge(e, d.scan.h);
+  ASSERT_FALSE(check.holds);
+  ASSERT_EQ(check.reasons.size(), 1u);
+  EXPECT_NE(check.reasons.front().find("refinement was stopped"), std::string::npos);
+  EXPECT_NE(check.reasons.front().find("100% of the step"), std::string::npos);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "relief_snake/snake.hpp"
+#include "relief_snake/step_anchors.hpp"
 #include "test_meshes.hpp"
 
 using namespace relief_snake;
@@ -208,4 +209,51 @@ TEST(Snake, NearestResamplingKeepsNewSnaxelsOffAOneTriangleWall) {
     walk_top = std::max(walk_top, position(mesh, p).z());
   EXPECT_GT(walk_top, 0.3);  // the failure the nearest point avoids
   for (const SurfacePoint& p : surface_between(mesh, a, b, fractions, true)) EXPECT_LT(position(mesh, p).z(), 0.1);
+}
+
+TEST(Snake, ACutLoopMakesTheNextIterationLookAtEverySnaxel) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  std::vector<SurfacePoint> pts = circle(mesh, Vec3(10, 10, 0), 5, 24);
+  std::swap(pts[6], pts[7]);
+  Snake snake(mesh, pts, true, true);
+  std::vector<char> moved;
+  snake.take_moved_flags(&moved);
+  EXPECT_FALSE(snake.take_moved_flags(&moved));  // nothing cut yet
+  ASSERT_GE(snake.remove_loops(), 1);
+  EXPECT_TRUE(snake.take_moved_flags(&moved));  // once after the cut
+  EXPECT_FALSE(snake.take_moved_flags(&moved));
+  // The flags themselves: only the two ends of the new segment (the greedy step decides which
+  // other snaxels it must look at, evolution.cpp).
+  Snake cut(mesh, pts, true, true);
+  cut.take_moved_flags(&moved);
+  ASSERT_GE(cut.remove_loops(), 1);
+  cut.take_moved_flags(&moved);
+  int flagged = 0;
+  for (const char m : moved) flagged += m;
+  EXPECT_EQ(flagged, 2);
+}
+
+TEST(Snake, AStepLeftCountsTheOnStepAnchorsNoSnaxelComesNear) {
+  const Mesh mesh = test::plane_mesh(41, 20);
+  const Vec3 c(10, 10, 0);
+  Snake snake(mesh, circle(mesh, c, 5, 80), true, true);
+  // 40 anchors on the snake's circle; 38, 39, 0 and 1 (a run across the start) and 20 moved out to
+  // radius 8, and anchor 10 off the step: 5 of 39 on-step anchors left, the longest run 4.
+  StepAnchors anchors;
+  for (int k = 0; k < 40; ++k) {
+    const double a = 2 * M_PI * k / 40;
+    const bool out = k == 38 || k == 39 || k == 0 || k == 1 || k == 20;
+    anchors.points.push_back(c + (out ? 8.0 : 5.0) * Vec3(std::cos(a), std::sin(a), 0));
+    anchors.on_step.push_back(k != 10);
+  }
+  anchors.spacing = 2 * M_PI * 5 / 40;
+  EXPECT_EQ(anchors.on_step_count(), 39);
+  const StepLeft left = step_left(anchors, snake, 1.0);
+  EXPECT_NEAR(left.share, 5.0 / 39, 1e-12);
+  EXPECT_NEAR(left.longest, 4 * anchors.spacing, 1e-12);
+  // Open contours' runs do not wrap: 38-39 and 0-1 are two runs of 2.
+  anchors.closed = false;
+  EXPECT_NEAR(step_left(anchors, snake, 1.0).longest, 2 * anchors.spacing, 1e-12);
+  // Within 3.5 of a snaxel every anchor is reached.
+  EXPECT_EQ(step_left(anchors, snake, 3.5).share, 0.0);
 }

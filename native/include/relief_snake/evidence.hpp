@@ -121,6 +121,9 @@ struct ContourEvidence {
   /// The refinement was abandoned with the contour enclosing this share of the coarse contour's
   /// area (ScheduleRun::abandoned; -1: it was not).
   double abandoned_area_share = -1;
+  /// The refinement was abandoned having left this share of the coarse contour's step
+  /// (RefineStop::max_left_share; -1: it was not).
+  double abandoned_left_share = -1;
   bool region_checked = false;  ///< the region-wide check ran and could measure the region
   /// Closed contours: the region's area against the area the picks enclose standing half a step (the
   /// lower of h and the step found) above the background along them (enclosure.hpp); -1: not measured.

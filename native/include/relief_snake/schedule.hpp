@@ -11,6 +11,7 @@
 #include "relief_snake/planarity.hpp"
 #include "relief_snake/segment.hpp"
 #include "relief_snake/snake.hpp"
+#include "relief_snake/step_anchors.hpp"
 #include "relief_snake/surface_point.hpp"
 
 namespace relief_snake {
@@ -24,12 +25,28 @@ struct ScheduleRun {
   bool cancelled = false;              ///< the progress callback asked to stop
   bool collapsed = false;              ///< the snake collapsed (collapsed_phase says where)
   std::string collapsed_phase;
-  /// The refinement was stopped early: the contour's vector area fell below min_area_share of the
-  /// coarse contour's (refine()); abandoned_area_share is the share it had then. contour holds
-  /// where it was; no stabilisation ran.
+  /// The refinement was stopped early (refine(), RefineStop): contour holds where it was; no
+  /// stabilisation ran. abandoned_area_share: the share of the coarse contour's vector area the
+  /// contour enclosed then; abandoned_left_share: the share of the coarse contour's step it had
+  /// left (-1: anchors were not given).
   bool abandoned = false;
+  bool abandoned_for_area = false;  ///< the area share fell below RefineStop::min_area_share (else: the step was left)
   double abandoned_area_share = 0;
+  double abandoned_left_share = -1;
   int refine_levels = 1;               ///< refinement spacings used
+};
+
+/// When a refinement from the coarse snake is stopped early (closed contours): it is carrying the
+/// snake across the relief, and finishing it would only cost time. Checked every lock_interval
+/// iterations.
+struct RefineStop {
+  /// Stop once the contour encloses less than this share of the coarse contour's vector area (0: never).
+  double min_area_share = 0;
+  /// The coarse contour's measured points and which sit on the step (null: no step check). Stop
+  /// once more than max_left_share of the on-step points have no snaxel within left_distance h.
+  const StepAnchors* anchors = nullptr;
+  double left_distance = 2;
+  double max_left_share = 0.1;
 };
 
 class EvolutionSchedule {
@@ -47,10 +64,8 @@ class EvolutionSchedule {
   const ScheduleRun& coarse(const ProgressCallback& progress);
   /// Refinement and stabilisation with this W_int, from the coarse snake. Runs the
   /// coarse phase first if needed. The returned phases include the coarse one.
-  /// min_area_share > 0 (closed contours): abandon the refinement once the contour encloses less
-  /// than this share of the coarse contour's vector area (ScheduleRun::abandoned): it is carrying
-  /// the snake across the relief, and finishing it would only cost time.
-  ScheduleRun refine(double w_int, const ProgressCallback& progress, double min_area_share = 0);
+  /// stop (closed contours): when to abandon the refinement (ScheduleRun::abandoned).
+  ScheduleRun refine(double w_int, const ProgressCallback& progress, const RefineStop& stop = {});
   /// Refinement and stabilisation with this W_int from another start (a repaired contour, already
   /// near the step: only the finest spacing runs). Runs the coarse phase first if needed (its
   /// phase is reported like refine()'s).
@@ -68,7 +83,7 @@ class EvolutionSchedule {
   ScheduleRun coarse_run_;
   std::unique_ptr<Snake> coarse_snake_;  // as the coarse phase left it
   ScheduleRun refine_snake(const Snake& start, bool all_levels, double w_int, const ProgressCallback& progress,
-                           double min_area_share = 0);
+                           const RefineStop& stop = {});
 };
 
 }  // namespace relief_snake

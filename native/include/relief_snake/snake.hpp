@@ -43,7 +43,10 @@ class Snake {
 
   // The greedy evolution's interface (evolution.cpp): the moved flags and the oscillation lock.
   /// Starts a greedy iteration: (*moved_before)[i] = snaxel i's moved flag, and every flag cleared.
-  void take_moved_flags(std::vector<char>* moved_before);
+  /// Returns true if a loop was cut since the last call (remove_loops()): the iteration then looks
+  /// at every snaxel again, as if every flag were set (see evolution.cpp for how it skips those
+  /// whose energies provably stand).
+  bool take_moved_flags(std::vector<char>* moved_before);
   /// A greedy move: move(i, p), and i flagged as moved (the next iteration looks at it and its
   /// neighbours again).
   void step(int i, const SurfacePoint& p);
@@ -111,6 +114,7 @@ class Snake {
   bool nearest_resampling_ = true;
   std::uint64_t version_ = 0;  // changes so far (stamps)
   std::uint64_t turns_checked_ = 0, spacing_checked_ = 0, loops_checked_ = 0;  // version_ when each last looked
+  bool revisit_all_ = false;  // a loop was cut since take_moved_flags()
   double spacing_l_ = -1;      // the l of the last resample()
 };
 
