@@ -112,6 +112,11 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
     result.noisy = true;
     return result;
   }
+  if (std::count_if(foot.begin(), foot.end(), [](double f) { return f < 0; }) > o.max_unclean_share * n) {
+    result.skipped = n;
+    result.unclean = true;
+    return result;
+  }
   // Median filter along the snake over the snaxels that have a foot.
   std::vector<double> window, smoothed(n, -1);
   for (int i = 0; i < n; ++i) {

@@ -52,6 +52,35 @@ TEST(Foot, MovesASnakeFromTheSlopeOutToTheFoot) {
   EXPECT_NEAR(mean_radius(outside), before, 0.03);
 }
 
+TEST(Foot, LeavesAContourMostlyWithoutCleanBackgroundAlone) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  FootOptions o;
+  o.h = scan.h;
+  o.max_unclean_share = 0.5;
+  Snake snake = circle_snake(mesh, scan, 11.75, 150);
+  const FootResult clean = settle_at_foot(&snake, o);
+  EXPECT_FALSE(clean.unclean);
+  EXPECT_GT(clean.moved, 120);
+  // A band beyond the mesh's edge for every snaxel: no clean background anywhere.
+  o.band_from = 30;
+  o.band_to = 40;
+  Snake far = circle_snake(mesh, scan, 11.75, 150);
+  const double before = mean_radius(far);
+  const FootResult none = settle_at_foot(&far, o);
+  EXPECT_TRUE(none.unclean);
+  EXPECT_EQ(none.moved, 0);
+  EXPECT_EQ(mean_radius(far), before);
+  o.max_unclean_share = 1.0;  // the plain foot stage: each snaxel on its own, nothing to move either
+  const FootResult plain = settle_at_foot(&far, o);
+  EXPECT_FALSE(plain.unclean);
+  EXPECT_EQ(plain.moved, 0);
+}
+
 TEST(Foot, LeavesANoisyBackgroundAlone) {
   syn::ScanSpec spec;
   spec.shape = syn::Shape::Disk;

@@ -173,3 +173,52 @@ INSTANTIATE_TEST_SUITE_P(Synthetic, SegmentScan, ::testing::ValuesIn(cases()),
                          });
 
 }  // namespace
+
+namespace {
+
+// Mean distance of a result's contour from the disk relief's foot circle (radius 12, centre 0).
+double mean_offset_from_foot(const Result& r) {
+  double sum = 0;
+  for (const Vec3& p : r.polyline) sum += std::hypot(p.x(), p.y()) - 12.0;
+  return r.polyline.empty() ? 1e9 : sum / r.polyline.size();
+}
+
+Result segment_disk(const syn::Scan& scan, bool foot_snap_blended) {
+  const Mesh mesh = syn::to_mesh(scan);
+  const syn::Picks picks = scan.picks(syn::PickSpec{});
+  Options options;
+  options.step_height = scan.h;
+  options.foot_snap_blended = foot_snap_blended;
+  return segment(mesh, picks.vertices, options);
+}
+
+}  // namespace
+
+// The foot stage where the step is blended over a clean background: a wide blend (one h, seven edges
+// per h) holds the snake part of the way up; the stage brings it down to the foot. On a sharp step
+// the gate stays shut and the contour is the same either way.
+TEST(SegmentFoot, BlendedStepsSettleAtTheFootSharpOnesAreLeftAlone) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.blend_width = 1.0;
+  spec.h = 3;  // seven edges per h
+  spec.triangles = 60000;
+  const syn::Scan blended = syn::generate(spec);
+  const Result off = segment_disk(blended, false), on = segment_disk(blended, true);
+  ASSERT_EQ(on.status, Status::Converged) << on.message;
+  const double edge = off.parameters.average_edge;
+  EXPECT_LT(mean_offset_from_foot(off), -0.5 * edge);  // up the slope, inside the foot
+  EXPECT_GT(mean_offset_from_foot(on), mean_offset_from_foot(off) + 0.3 * edge);
+  EXPECT_LT(std::fabs(mean_offset_from_foot(on)), 0.5 * edge);
+  bool settled = false;
+  for (const std::string& n : on.notes) settled = settled || n.find("settled at the foot") != std::string::npos;
+  EXPECT_TRUE(settled);
+
+  spec.step = syn::Step::Sharp;
+  const syn::Scan sharp = syn::generate(spec);
+  const Result sharp_off = segment_disk(sharp, false), sharp_on = segment_disk(sharp, true);
+  ASSERT_EQ(sharp_on.polyline.size(), sharp_off.polyline.size());
+  for (std::size_t k = 0; k < sharp_on.polyline.size(); ++k)
+    EXPECT_EQ(sharp_on.polyline[k], sharp_off.polyline[k]);
+}

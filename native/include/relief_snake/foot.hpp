@@ -19,6 +19,9 @@ struct FootOptions {
   /// No snap at all when the background's median residual (in h) exceeds this: noise then
   /// hides the foot (measured: the snap made the contour worse at noise 0.03 h).
   double max_noise = 0.005;
+  /// No snap at all when more than this share of the snaxels has no clean background band outside:
+  /// moving the rest alone makes the contour jagged (measured on the real eyebrow scan).
+  double max_unclean_share = 1.0;
 };
 
 struct FootResult {
@@ -27,6 +30,7 @@ struct FootResult {
   double mean_move = 0;      ///< mean distance moved (of the moved ones)
   double background_residual = 0;  ///< median residual of the background fits
   bool noisy = false;        ///< nothing moved: the background is too noisy
+  bool unclean = false;      ///< nothing moved: too few snaxels have a clean background outside
 };
 
 /// For each snaxel of `snake`, walks outwards along the surface, fits the background

@@ -65,6 +65,10 @@ struct Options {
   /// After stabilisation, move each snaxel out to the foot of the step, where the surface
   /// leaves the background continued from outside (foot.hpp; not in the paper).
   bool foot_snap = false;
+  /// The foot stage only where the contour sits on a blended step over a clean background (half
+  /// the step at least 1.5 edges inside it, outside planes' residual under 5% of h); foot_snap
+  /// puts it everywhere (not in the paper).
+  bool foot_snap_blended = true;
   /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
