@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "relief_snake/evidence.hpp"
+
 #include "relief_snake/region.hpp"
 #include "relief_snake/step_height.hpp"
 
@@ -42,10 +44,7 @@ double covered_share(const Mesh& mesh, const Enclosure& enclosure, const std::ve
   if (!(judged > 0) || enclosure.heights.empty()) return -1;
   const double risen = risen_area(enclosure, options.rise * judged);
   if (risen < options.min_area * judged * judged && risen < options.min_share * enclosure.enclosed_area) return -1;
-  double area = 0;
-  for (int v = 0; v < mesh.n_vertices(); ++v)
-    if (region[v]) area += mesh.vertex_area(v);
-  return area / risen;
+  return region_area(mesh, region) / risen;
 }
 
 std::string enclosure_reason(const Enclosure& enclosure, double h, const EnclosureOptions& options) {

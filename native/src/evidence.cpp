@@ -38,14 +38,11 @@ void gather_ball(const Mesh& mesh, int v0, const Vec3& centre, double radius, st
   }
 }
 
-// The longest run of consecutive set flags (a closed contour's runs wrap round), in flags,
-// and the index of its middle flag (-1 when none is set).
-struct Run {
-  int length = 0, middle = -1;
-};
-Run longest_run(const std::vector<char>& flags, bool closed) {
+}  // namespace
+
+FlagRun longest_run(const std::vector<char>& flags, bool closed) {
   const int m = static_cast<int>(flags.size());
-  Run best;
+  FlagRun best;
   int run = 0;
   // Going round twice lets a run wrap; runs are capped at m.
   for (int k = 0; k < (closed ? 2 * m : m); ++k) {
@@ -54,8 +51,6 @@ Run longest_run(const std::vector<char>& flags, bool closed) {
   }
   return best;
 }
-
-}  // namespace
 
 double region_area(const Mesh& mesh, const std::vector<char>& region) {
   double area = 0;
@@ -222,7 +217,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     const double far = evidence.offset_median + std::max(options.offset_tolerance * h, 2 * edge);
     std::vector<char> far_flags(m);
     for (int k = 0; k < m; ++k) far_flags[k] = evidence.profiles[k].offset > far;
-    const Run far_run = longest_run(far_flags, options.closed);
+    const FlagRun far_run = longest_run(far_flags, options.closed);
     if (far_run.length > 0) evidence.far_point = evidence.profiles[far_run.middle].contour_index;
     evidence.offset_q90 = quantile(offsets, 0.9);
     evidence.offset_q75 = quantile(offsets, 0.75);

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "grid.hpp"
+#include "relief_snake/initial_contour.hpp"
 
 namespace relief_snake {
 
@@ -15,9 +16,7 @@ StepAnchors step_anchors(const Mesh& mesh, const std::vector<SurfacePoint>& cont
   StepAnchors anchors;
   anchors.closed = closed;
   const int n = static_cast<int>(contour.size());
-  double length = 0;
-  for (int k = 0; k + (closed ? 0 : 1) < n; ++k)
-    length += (position(mesh, contour[(k + 1) % n]) - position(mesh, contour[k])).norm();
+  const double length = path_length(mesh, contour, closed);
   for (const StepProfile& p : evidence.profiles) {
     if (p.contour_index < 0 || p.contour_index >= n) continue;
     anchors.points.push_back(position(mesh, contour[p.contour_index]));
@@ -50,24 +49,11 @@ StepLeft step_left(const StepAnchors& anchors, const Snake& snake, double distan
             if ((snake[i].position - a).squaredNorm() <= d2) reached[k] = 1;
           });
   }
-  int left = 0;
-  for (int k = 0; k < m; ++k) left += anchors.on_step[k] && !reached[k];
-  out.share = double(left) / on;
-  if (left == 0) return out;
-  // Runs of consecutive left on-step anchors (an off-step or reached anchor ends a run); a
-  // closed contour's run may wrap around.
-  auto is_left = [&](int k) { return anchors.on_step[k] && !reached[k]; };
-  int start = 0;
-  if (anchors.closed && left < m) {
-    while (is_left(start)) ++start;  // begin just after a non-left anchor
-  }
-  int run = 0, longest = 0;
-  for (int j = 0; j < m; ++j) {
-    const int k = (start + j) % m;
-    if (is_left(k)) longest = std::max(longest, ++run);
-    else run = 0;
-  }
-  out.longest = longest * anchors.spacing;
+  // Left: on the step and not reached (an off-step or reached anchor ends a run).
+  std::vector<char> left(m, 0);
+  for (int k = 0; k < m; ++k) left[k] = anchors.on_step[k] && !reached[k];
+  out.share = double(std::count(left.begin(), left.end(), char(1))) / on;
+  out.longest = longest_run(left, anchors.closed).length * anchors.spacing;
   return out;
 }
 

@@ -70,6 +70,14 @@ Tally tally(const syn::PlateScan& plate, const rs::DetectResult& result, double 
   return t;
 }
 
+// A 40k-triangle plate with two disks of radius 7, 40 apart.
+syn::PlateScan two_disks() {
+  syn::PlateSpec spec;
+  spec.triangles = 40000;
+  spec.reliefs = {disk(-20, 0, 7, 1), disk(20, 0, 7, 1)};
+  return syn::generate_plate(spec);
+}
+
 }  // namespace
 
 TEST(SegmentMany, OneSnakePerGroupSharingThePlanarity) {
@@ -209,10 +217,7 @@ TEST(Detect, TouchingReliefsOfDifferentHeightsStayApart) {
 }
 
 TEST(Detect, RegionAndOptions) {
-  syn::PlateSpec spec;
-  spec.triangles = 40000;
-  spec.reliefs = {disk(-20, 0, 7, 1), disk(20, 0, 7, 1)};
-  const syn::PlateScan plate = syn::generate_plate(spec);
+  const syn::PlateScan plate = two_disks();
   const rs::Mesh mesh = syn::to_mesh(plate.scan);
   rs::Segmenter segmenter(mesh);
   // The left half only: one relief.
@@ -241,10 +246,7 @@ TEST(Detect, ReportsProgressBeforeRefiningAndCancelsThere) {
   // The background fits and the components call progress too (front ends show them and can
   // cancel there): "background" before each of the three fits, "candidates" with their count,
   // and only then the snake's phases.
-  syn::PlateSpec spec;
-  spec.triangles = 40000;
-  spec.reliefs = {disk(-20, 0, 7, 1), disk(20, 0, 7, 1)};
-  const syn::PlateScan plate = syn::generate_plate(spec);
+  const syn::PlateScan plate = two_disks();
   const rs::Mesh mesh = syn::to_mesh(plate.scan);
   rs::Segmenter segmenter(mesh);
   struct Call {

@@ -28,14 +28,20 @@ double mean_radius(const Snake& snake) {
   return sum / snake.size();
 }
 
+// The disk relief (radius 12: the foot of its blended step is at r = 12) on 60k triangles.
+syn::Scan blended_disk(double noise = 0) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.triangles = 60000;
+  spec.noise = noise;
+  return syn::generate(spec);
+}
+
 }  // namespace
 
 TEST(Foot, MovesASnakeFromTheSlopeOutToTheFoot) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;  // radius 12: the foot of the blended step is at r = 12
-  spec.step = syn::Step::Blended;
-  spec.triangles = 60000;
-  const syn::Scan scan = syn::generate(spec);
+  const syn::Scan scan = blended_disk();
   const Mesh mesh = syn::to_mesh(scan);
   Snake snake = circle_snake(mesh, scan, 11.75, 150);  // a quarter h up the slope
   ASSERT_LT(mean_radius(snake), 11.85);
@@ -53,11 +59,7 @@ TEST(Foot, MovesASnakeFromTheSlopeOutToTheFoot) {
 }
 
 TEST(Foot, LeavesAContourMostlyWithoutCleanBackgroundAlone) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;
-  spec.step = syn::Step::Blended;
-  spec.triangles = 60000;
-  const syn::Scan scan = syn::generate(spec);
+  const syn::Scan scan = blended_disk();
   const Mesh mesh = syn::to_mesh(scan);
   FootOptions o;
   o.h = scan.h;
@@ -82,12 +84,7 @@ TEST(Foot, LeavesAContourMostlyWithoutCleanBackgroundAlone) {
 }
 
 TEST(Foot, LeavesANoisyBackgroundAlone) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;
-  spec.step = syn::Step::Blended;
-  spec.triangles = 60000;
-  spec.noise = 0.05;
-  const syn::Scan scan = syn::generate(spec);
+  const syn::Scan scan = blended_disk(0.05);
   const Mesh mesh = syn::to_mesh(scan);
   Snake snake = circle_snake(mesh, scan, 11.75, 300);
   const double before = mean_radius(snake);

@@ -52,6 +52,18 @@ double enclosed(const Mesh& mesh, const std::vector<SurfacePoint>& contour) {
   return vector_area(line).norm();
 }
 
+// The self-check's verdict on an otherwise good contour whose refinement was abandoned.
+SelfCheck abandoned_verdict(double h, double area_share, double left_share) {
+  ContourEvidence e;
+  e.step.attempted = 10;
+  e.step.profiles.resize(10);
+  e.step.step_share = 1.0;
+  e.step.step_height = h;
+  e.abandoned_area_share = area_share;
+  e.abandoned_left_share = left_share;
+  return judge(e, h);
+}
+
 RefineStop area_stop(double share) {
   RefineStop stop;
   stop.min_area_share = share;
@@ -90,13 +102,7 @@ TEST(Schedule, ARefinementBelowItsAreaShareIsAbandoned) {
   EXPECT_LT(run.abandoned_area_share, 2.0);
   EXPECT_NEAR(run.abandoned_area_share, enclosed(d.mesh, run.contour) / enclosed(d.mesh, coarse.contour), 1e-9);
   // The self-check names it.
-  ContourEvidence e;
-  e.step.attempted = 10;
-  e.step.profiles.resize(10);
-  e.step.step_share = 1.0;
-  e.step.step_height = d.scan.h;
-  e.abandoned_area_share = run.abandoned_area_share;
-  const SelfCheck check = judge(e, d.scan.h);
+  const SelfCheck check = abandoned_verdict(d.scan.h, run.abandoned_area_share, -1);
   ASSERT_FALSE(check.holds);
   ASSERT_EQ(check.reasons.size(), 1u);
   EXPECT_NE(check.reasons.front().find("refinement was stopped"), std::string::npos);
@@ -145,13 +151,7 @@ TEST(Schedule, ARefinementThatLeavesTheCoarseStepIsAbandoned) {
   const ScheduleRun kept = d.schedule->refine(0.25, nullptr, stop);
   EXPECT_FALSE(kept.abandoned);
   // The self-check names it.
-  ContourEvidence e;
-  e.step.attempted = 10;
-  e.step.profiles.resize(10);
-  e.step.step_share = 1.0;
-  e.step.step_height = d.scan.h;
-  e.abandoned_left_share = run.abandoned_left_share;
-  const SelfCheck check = judge(e, d.scan.h);
+  const SelfCheck check = abandoned_verdict(d.scan.h, -1, run.abandoned_left_share);
   ASSERT_FALSE(check.holds);
   ASSERT_EQ(check.reasons.size(), 1u);
   EXPECT_NE(check.reasons.front().find("refinement was stopped"), std::string::npos);

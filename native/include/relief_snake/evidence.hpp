@@ -160,6 +160,13 @@ Vec3 vector_area(const std::vector<Vec3>& closed_polyline);
 /// Vector area of the faces whose corners are all in the region (#V flags).
 Vec3 region_vector_area(const Mesh& mesh, const std::vector<char>& region);
 
+/// The longest run of consecutive set flags (a closed contour's runs wrap round), in flags, and the
+/// index of its middle flag (-1 when none is set).
+struct FlagRun {
+  int length = 0, middle = -1;
+};
+FlagRun longest_run(const std::vector<char>& flags, bool closed);
+
 /// Area (sum of vertex areas) of the flagged vertices.
 double region_area(const Mesh& mesh, const std::vector<char>& region);
 /// Area-weighted intersection over union of two vertex flag sets (1 when both are empty).
