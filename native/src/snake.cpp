@@ -100,14 +100,8 @@ SurfacePoint slide_along_boundary(const Mesh& mesh, const SurfacePoint& p, doubl
     const double ahead = forward ? b[ka] / std::max(1e-300, b[ka] + b[kb]) : b[kb] / std::max(1e-300, b[ka] + b[kb]);
     if (remaining <= ahead * len || len <= 0) {
       const double t = len > 0 ? remaining / len : 0;
-      double wa = b[ka] / (b[ka] + b[kb]), wb = 1 - wa;
-      if (forward) {
-        wa -= t;
-        wb += t;
-      } else {
-        wa += t;
-        wb -= t;
-      }
+      // ka's weight along the edge after moving t of it (kb's is the rest).
+      const double wa = b[ka] / (b[ka] + b[kb]) + (forward ? -t : t);
       SurfacePoint out;
       out.face = f;
       out.bary = Vec3::Zero();
