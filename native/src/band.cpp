@@ -223,10 +223,7 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
     std::vector<double> tried = {h};
     for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
       const double found = best.step_found();
-      if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
-      bool near_tried = false;
-      for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
-      if (near_tried) break;
+      if (!refit_wanted(found, best.h, tried, options)) break;
       tried.push_back(found);
       BandAttempt next = attempt_at(found);
       if (cancelled) break;

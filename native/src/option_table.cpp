@@ -165,6 +165,8 @@ const std::vector<Row>& rows() {
               "segment again with the step measured along the contour when it disagrees with h (not in the paper)"),
       number("refit_ratio", &Options::refit_ratio, "> 1", [](double x) { return x > 1; },
              "refit h when the step found and h differ by more than this factor"),
+      number("refit_ratio_up", &Options::refit_ratio_up, "> 1", [](double x) { return x > 1; },
+             "refit h already when the step found exceeds h by this factor (at most refit_ratio)"),
       boolean("foot_snap", &Options::foot_snap,
               "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
               "the background (not in the paper)"),

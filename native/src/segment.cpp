@@ -46,6 +46,15 @@ const char* to_string(Status status) {
   return "unknown";
 }
 
+bool refit_wanted(double found, double h_used, const std::vector<double>& tried, const Options& options) {
+  if (!(found > 0) || !(h_used > 0)) return false;
+  const double ratio = found / h_used;
+  if (ratio < std::min(options.refit_ratio_up, options.refit_ratio) && ratio * options.refit_ratio > 1) return false;
+  for (const double t : tried)
+    if (std::fabs(std::log(found / t)) < std::log(1.15)) return false;
+  return true;
+}
+
 std::vector<std::pair<const char*, double>> DerivedParameters::named_values() const {
   return {{"coarse_spacing", coarse_spacing}, {"refine_spacing", refine_spacing}, {"alpha_coarse", alpha_coarse},
           {"beta_coarse", beta_coarse},       {"alpha_refine", alpha_refine},     {"beta_refine", beta_refine},
@@ -79,6 +88,7 @@ void validate_options(const Mesh& mesh, const Options& o) {
   if (o.max_iterations < 1) throw Error("max_iterations must be at least 1 (got " + std::to_string(o.max_iterations) + ")");
   if (o.threads < 0) throw Error("threads must be 0 (all cores) or a positive count (got " + std::to_string(o.threads) + ")");
   if (!(o.refit_ratio > 1) || !std::isfinite(o.refit_ratio)) throw Error("refit_ratio must be a number > 1");
+  if (!(o.refit_ratio_up > 1) || !std::isfinite(o.refit_ratio_up)) throw Error("refit_ratio_up must be a number > 1");
   if (!(o.feature_contrast > 0) || !std::isfinite(o.feature_contrast))
     throw Error("feature_contrast must be a positive number");
 }
@@ -499,10 +509,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   std::vector<double> tried = {h};
   for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
     const double found = best.evidence.step.step_height;
-    if (!(found > 0) || std::fabs(std::log(found / best.h)) < std::log(options.refit_ratio)) break;
-    bool near_tried = false;
-    for (const double t : tried) near_tried = near_tried || std::fabs(std::log(found / t)) < std::log(1.15);
-    if (near_tried) break;
+    if (!refit_wanted(found, best.h, tried, options)) break;
     tried.push_back(found);
     Attempt next = attempt_at(found);
     if (cancelled) break;

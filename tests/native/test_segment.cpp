@@ -3,6 +3,7 @@
 // boundary on average, and the relief region has IoU >= 0.95 with the truth.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 #include <string>
 
@@ -221,4 +222,55 @@ TEST(SegmentFoot, BlendedStepsSettleAtTheFootSharpOnesAreLeftAlone) {
   ASSERT_EQ(sharp_on.polyline.size(), sharp_off.polyline.size());
   for (std::size_t k = 0; k < sharp_on.polyline.size(); ++k)
     EXPECT_EQ(sharp_on.polyline[k], sharp_off.polyline[k]);
+}
+
+// When the step found along the contour calls for segmenting again: above h from refit_ratio_up on,
+// below it from refit_ratio on, never within x1.15 of an h already tried, and refit_ratio caps the
+// upward threshold.
+TEST(SegmentRefit, AStepFoundAboveHIsRefittedSoonerThanOneBelow) {
+  Options o;  // refit_ratio 1.3, refit_ratio_up 1.15
+  EXPECT_TRUE(refit_wanted(1.2, 1.0, {1.0}, o));
+  EXPECT_FALSE(refit_wanted(1.1, 1.0, {1.0}, o));
+  EXPECT_FALSE(refit_wanted(1.0 / 1.2, 1.0, {1.0}, o));  // below h by x1.2: not yet
+  EXPECT_TRUE(refit_wanted(1.0 / 1.35, 1.0, {1.0}, o));
+  EXPECT_FALSE(refit_wanted(1.2, 1.0, {1.0, 1.25}, o));  // 1.25 was tried already
+  EXPECT_FALSE(refit_wanted(0, 1.0, {1.0}, o));
+  EXPECT_FALSE(refit_wanted(std::nan(""), 1.0, {1.0}, o));
+  o.refit_ratio_up = 1.5;  // refit_ratio caps the upward threshold
+  EXPECT_TRUE(refit_wanted(1.4, 1.0, {1.0}, o));
+  o.refit_ratio_up = 1.3;  // symmetric, as before issue 14's second wave
+  EXPECT_FALSE(refit_wanted(1.2, 1.0, {1.0}, o));
+}
+
+// A disk blended over 1 h (seven edges per h), h typed x0.75: the small h holds the snake up the slope,
+// where the step found (x1.28 h) was within x1.3 of h and nothing was refitted. A step found above h is
+// now refitted from x1.15 on, and the contour comes down towards the foot. The foot stage is off so
+// that only the refit moves it.
+TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwards) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.blend_width = 1.0;
+  spec.h = 3;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  const syn::Picks picks = scan.picks(syn::PickSpec{});
+  Options options;
+  options.step_height = 0.75 * scan.h;
+  options.foot_snap_blended = false;
+  Options symmetric = options;
+  symmetric.refit_ratio_up = symmetric.refit_ratio;
+  const Result refitted = segment(mesh, picks.vertices, options), before = segment(mesh, picks.vertices, symmetric);
+  ASSERT_FALSE(refitted.polyline.empty()) << refitted.message;
+  ASSERT_FALSE(before.polyline.empty()) << before.message;
+  EXPECT_EQ(before.parameters.step_height, options.step_height);  // nothing refitted
+  EXPECT_GT(refitted.parameters.step_height, 0.9 * scan.h);
+  bool noted = false;
+  for (const std::string& n : refitted.notes) noted = noted || n.find("segmented again with h") != std::string::npos;
+  EXPECT_TRUE(noted);
+  EXPECT_EQ(refitted.status, Status::Converged) << refitted.message;
+  const double edge = refitted.parameters.average_edge;
+  // Measured: 1.41 edges inside the foot before, 0.87 refitted (h 2.25, then 2.88 for a true 3).
+  EXPECT_GT(mean_offset_from_foot(refitted), mean_offset_from_foot(before) + 0.3 * edge);
 }
