@@ -599,6 +599,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"offset_q95", step.offset_q95 / best.h},
                    {"far_share", step.far_share},
                    {"far_run", step.longest_far / best.h},
+                   {"foot_gap_median", step.foot_gap_median / best.h},
+                   {"foot_gap_q75", step.foot_gap_q75 / best.h},
+                   {"foot_gap_contour", step.foot_gap_contour / best.h},
                    {"background_depth", best.evidence.background_depth},
                    {"background_area", best.evidence.background_area}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});

@@ -227,8 +227,10 @@ TEST(SegmentFoot, BlendedStepsSettleAtTheFootSharpOnesAreLeftAlone) {
 // When the step found along the contour calls for segmenting again: above h from refit_ratio_up on,
 // below it from refit_ratio on, never within x1.15 of an h already tried, and refit_ratio caps the
 // upward threshold.
-TEST(SegmentRefit, AStepFoundAboveHIsRefittedSoonerThanOneBelow) {
-  Options o;  // refit_ratio 1.3, refit_ratio_up 1.15
+TEST(SegmentRefit, AStepFoundAboveHCanBeRefittedSoonerThanOneBelow) {
+  Options o;
+  o.refit_ratio = 1.3;
+  o.refit_ratio_up = 1.15;
   EXPECT_TRUE(refit_wanted(1.2, 1.0, {1.0}, o));
   EXPECT_FALSE(refit_wanted(1.1, 1.0, {1.0}, o));
   EXPECT_FALSE(refit_wanted(1.0 / 1.2, 1.0, {1.0}, o));  // below h by x1.2: not yet
@@ -238,15 +240,16 @@ TEST(SegmentRefit, AStepFoundAboveHIsRefittedSoonerThanOneBelow) {
   EXPECT_FALSE(refit_wanted(std::nan(""), 1.0, {1.0}, o));
   o.refit_ratio_up = 1.5;  // refit_ratio caps the upward threshold
   EXPECT_TRUE(refit_wanted(1.4, 1.0, {1.0}, o));
-  o.refit_ratio_up = 1.3;  // symmetric, as before issue 14's second wave
+  o.refit_ratio_up = 1.3;  // symmetric: the default
   EXPECT_FALSE(refit_wanted(1.2, 1.0, {1.0}, o));
+  EXPECT_EQ(Options().refit_ratio_up, Options().refit_ratio);
 }
 
 // A disk blended over 1 h (seven edges per h), h typed x0.75: the small h holds the snake up the slope,
-// where the step found (x1.28 h) was within x1.3 of h and nothing was refitted. A step found above h is
-// now refitted from x1.15 on, and the contour comes down towards the foot. The foot stage is off so
-// that only the refit moves it.
-TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwards) {
+// where the step found (x1.28 h) is within x1.3 of h and, by default, nothing is refitted. With a step
+// found above h refitted from x1.15 on (refit_ratio_up), the contour comes down towards the foot. The
+// foot stage is off so that only the refit moves it.
+TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwardsFromRefitRatioUp) {
   syn::ScanSpec spec;
   spec.shape = syn::Shape::Disk;
   spec.step = syn::Step::Blended;
@@ -259,6 +262,7 @@ TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwards) {
   Options options;
   options.step_height = 0.75 * scan.h;
   options.foot_snap_blended = false;
+  options.refit_ratio_up = 1.15;
   Options symmetric = options;
   symmetric.refit_ratio_up = symmetric.refit_ratio;
   const Result refitted = segment(mesh, picks.vertices, options), before = segment(mesh, picks.vertices, symmetric);
@@ -273,4 +277,51 @@ TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwards) {
   const double edge = refitted.parameters.average_edge;
   // Measured: 1.41 edges inside the foot before, 0.87 refitted (h 2.25, then 2.88 for a true 3).
   EXPECT_GT(mean_offset_from_foot(refitted), mean_offset_from_foot(before) + 0.3 * edge);
+}
+
+namespace {
+double check_value(const Result& r, const std::string& name) {
+  for (const auto& [k, v] : r.checks)
+    if (k == name) return v;
+  return std::nan("");
+}
+}  // namespace
+
+// The foot gap (evidence.hpp): a disk blended over 1 h (seven edges per h). With h typed x0.55 the snake
+// settles 4 edges up the slope; before the check it came back converged, now it is doubtful and says
+// why. At x0.6 the check turns down the attempts up the slope and a larger W_int, then the refit, bring
+// the contour to the foot. At the true h the contour is at the foot and the gap is nil.
+TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.blend_width = 1.0;
+  spec.h = 3;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  const syn::Picks picks = scan.picks(syn::PickSpec{});
+  const double edge = mesh.average_edge_length();
+  auto run = [&](double factor) {
+    Options options;
+    options.step_height = factor * scan.h;
+    return segment(mesh, picks.vertices, options);
+  };
+  const Result up = run(0.55);
+  ASSERT_FALSE(up.polyline.empty()) << up.message;
+  EXPECT_EQ(up.status, Status::Doubtful);
+  bool said = false;
+  for (const std::string& r : up.reasons) said = said || r.find("keeps rising") != std::string::npos;
+  EXPECT_TRUE(said) << up.message;
+  EXPECT_GT(check_value(up, "foot_gap_median") * up.parameters.step_height, 1.5 * edge);
+
+  const Result rescued = run(0.6);
+  ASSERT_FALSE(rescued.polyline.empty()) << rescued.message;
+  EXPECT_EQ(rescued.status, Status::Converged) << rescued.message;
+  EXPECT_LT(std::fabs(mean_offset_from_foot(rescued)), 0.5 * edge);  // measured: 0.2 edges
+
+  const Result right = run(1.0);
+  EXPECT_EQ(right.status, Status::Converged) << right.message;
+  EXPECT_EQ(check_value(right, "foot_gap_median"), 0.0);
+  EXPECT_LT(std::fabs(mean_offset_from_foot(right)), 0.5 * edge);
 }

@@ -41,6 +41,11 @@ struct EvidenceOptions {
   double offset_tolerance = 0.5; ///< a point is far from the step if its offset exceeds the median by this (in h, >= 2 edges)
   double front_low = 0.5;       ///< a front below this share of the step found (and below min_rise h) is low
   bool closed = true;           ///< the contour is closed: its runs wrap around
+  /// The foot gap (StepProfile::foot_gap): the background plane is fitted to the outside vertices at
+  /// least foot_gap_from h (and foot_gap_from_edges average edges) outwards across the contour.
+  double foot_gap_from = 1.0, foot_gap_from_edges = 3;
+  double foot_gap_level = 0.05;  ///< the walk stops at a bin below this share of the rise (on the clean blended disk of
+                                 ///< SegmentFootGap, 0.15 read 1 edge for a contour 2.5 edges up the slope)
 };
 
 /// One measured contour point.
@@ -55,6 +60,12 @@ struct StepProfile {
   bool front_measured = false;  ///< enough inside vertices behind the point
   bool front_low = false;       ///< measured, and the inside right behind is well below the step found
   double offset = 0;            ///< distance inwards to the first inside vertex at half the step found (ball radius: none)
+  /// Distance outwards from the point to where the surface comes down to the background: the
+  /// heights of the outside vertices in a strip across the contour, above a plane fitted beyond
+  /// foot_gap_from, in bins of one average edge, walked outwards until a bin's median is below
+  /// foot_gap_level of the rise (and 3 times that plane's residual). 0 at a step's foot; partway up a
+  /// blended step, the part of the slope left outside (short of it by the bin the walk stops in).
+  double foot_gap = 0;
 };
 
 struct StepEvidence {
@@ -72,6 +83,12 @@ struct StepEvidence {
   double far_share = 0;               ///< share of profiles whose offset exceeds the median by the tolerance
   double longest_far = 0;             ///< longest run of such profiles, as contour length
   int far_point = -1;                 ///< contour index in the middle of that run (-1: none)
+  double foot_gap_median = 0, foot_gap_q75 = 0;  ///< of the on-step profiles' foot gaps (mesh units)
+  /// The contour's foot gap: the walk over the median, bin by bin, of the on-step profiles' bins,
+  /// against the level or three standard errors of that median (texture and noise average out along
+  /// the contour, a slope left outside does not), the crossing interpolated (mesh units).
+  double foot_gap_contour = 0;
+  double average_edge = 0;            ///< the mesh's, for the checks measured in edges
   double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
 };
 
@@ -109,6 +126,11 @@ struct SelfCheckOptions {
   /// suite (400 scans, typed and estimated h) right results covered at least 0.29, the wrong ones
   /// under 0.15.
   double min_covered_share = 0.2;
+  /// Median foot gap (StepEvidence::foot_gap_median) allowed, in average edges: more, and the contour
+  /// runs partway up the step over most of its length (an h too small holds it on a blended step's
+  /// slope). Accuracy is judged to one average edge; the gap is measured in whole bins of one edge and
+  /// falls short of the slope left outside.
+  double max_foot_gap_edges = 1.5;
 };
 
 /// Everything the self-check looks at for one contour.

@@ -42,13 +42,15 @@ struct Options {
   bool refit_step_height = true;
   double refit_ratio = 1.3;
   /// A step found above h is refitted from this factor on (at most refit_ratio). Measured from a
-  /// contour partway up a blended step, the step found is short of the true one, never over it,
-  /// so a step found above h is the surer sign that h is too small (a small h is also what
-  /// holds a snake up the slope). On the randomized suite 1.15 took accurate results from 177 to
-  /// 182 of 200 (seeds 0:200), 174 to 176 and 172 to 176 (held out: 1000:1200, 2000:2200), and
-  /// wrong ones reported converged from 28 to 23 in all; refitting a step found below h from x1.15
-  /// on as well turned a right result on seeds 0:200 into a silent wrong one (docs/design.md).
-  double refit_ratio_up = 1.15;
+  /// contour partway up a blended step, the step found is short of the true one, so a step found
+  /// above h is the surer sign that h is too small (and a small h is what holds the snake up the
+  /// slope). 1.15 on the randomized suite: accurate 177 -> 182 of 200 (seeds 0:200), 174 -> 176 and
+  /// 172 -> 176 (held out 1000:1200, 2000:2200), wrong and converged 28 -> 23 in all. Not the default:
+  /// on seed 1014 of the CI sample (tests/python/test_random_suite.py) it turns a result flagged for
+  /// a bridged concavity into a near miss reported converged (1.6 edges up a blended, striated,
+  /// noisy step; the true h gives the same, 1.4 edges), and the contract that every wrong result is
+  /// flagged holds on that sample today (docs/design.md).
+  double refit_ratio_up = 1.3;
 
   // Fixed by the paper; exposed for experiments and the benchmark.
   double tau = 0.2;                ///< movement step, fraction of the local segment length
