@@ -51,7 +51,7 @@ from bench.run import EXIT_DOUBTFUL, REPO, machine_info, run_engine, runaway_lim
 OLD_DEFAULTS = ("--w-int 0.25 --max-iterations 3000 tau=0.2 epsilon=0.2 q_samples=5 exact_q=0 max_turn_degrees=160 "
                 "lock_interval=10 feature_contrast=0.25 scale_feature_with_spacing=1 convex_barrier=0 remove_loops=1 "
                 "foot_snap=0 refine_levels=1 nearest_resampling=1 neighbourhood=sphere plane_fit=vertex_areas "
-                "planarity_one_ring=1 refit_step_height=0 repair_background=0 foot_snap_blended=0")
+                "planarity_one_ring=1 refit_step_height=0 repair_background=0 foot_snap_blended=0 wall_foot=0")
 BUILTIN_VARIANTS = {"defaults": "", "paper": f"--w-int {PAPER_W_INT} " + " ".join(PAPER),
                     "auto-h": "--step-height auto", "old-defaults": OLD_DEFAULTS}
 

@@ -177,4 +177,50 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   return result;
 }
 
+WallResult settle_down_walls(const Mesh& mesh, std::vector<SurfacePoint>* contour, const std::vector<char>& region,
+                             const WallOptions& options) {
+  WallResult result;
+  const double edge = mesh.average_edge_length();
+  for (SurfacePoint& p : *contour) {
+    if (!p.valid()) continue;
+    int in = 0;
+    for (int k = 0; k < 3; ++k) in += region[mesh.face_vertex(p.face, k)] ? 1 : 0;
+    if (in == 0 || in == 3) continue;
+    // The background normal: the faces round the outside corners whose corners are all outside.
+    Vec3 background = Vec3::Zero(), low = Vec3::Zero();
+    int n_low = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.face_vertex(p.face, k);
+      if (region[v]) continue;
+      low += mesh.position(v), ++n_low;
+      for (const int* f = mesh.faces_begin(v); f != mesh.faces_end(v); ++f) {
+        bool outside = true;
+        for (int j = 0; j < 3; ++j) outside = outside && !region[mesh.face_vertex(*f, j)];
+        if (outside) background += mesh.face_area(*f) * mesh.face_normal(*f);
+      }
+    }
+    if (!(background.norm() > 0)) continue;
+    background.normalize();
+    if (std::fabs(mesh.face_normal(p.face).dot(background)) > options.max_cosine) continue;
+    low /= n_low;
+    double height = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.face_vertex(p.face, k);
+      if (region[v]) height += (mesh.position(v) - low).dot(background) / in;
+    }
+    if (height < options.min_height_edges * edge) continue;
+    double up = 0;
+    for (int k = 0; k < 3; ++k)
+      if (region[mesh.face_vertex(p.face, k)]) up += p.bary[k];
+    if (!(up > 0)) continue;  // already on the wall's lower edge
+    if (up * height < options.min_snaxel_height_edges * edge) continue;
+    Vec3 bary = p.bary;
+    for (int k = 0; k < 3; ++k)
+      if (region[mesh.face_vertex(p.face, k)]) bary[k] *= options.keep;
+    p.bary = bary / bary.sum();
+    ++result.moved;
+  }
+  return result;
+}
+
 }  // namespace relief_snake

@@ -170,6 +170,8 @@ const std::vector<Row>& rows() {
       boolean("foot_snap", &Options::foot_snap,
               "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
               "the background (not in the paper)"),
+      boolean("wall_foot", &Options::wall_foot,
+              "move snaxels resting on a sharp step's tall wall down to its foot (not in the paper)"),
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),

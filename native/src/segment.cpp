@@ -356,10 +356,12 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       };
       if (options.foot_snap) settle_at_the_foot(false);
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
+      if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
       a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length())) {
         settle_at_the_foot(true);
         a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
+        if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
         a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       }
       a.evidence.covered_share = covered_share(mesh, enclosure, a.region, h_try, a.evidence.step.step_height);

@@ -45,7 +45,7 @@ struct EvidenceOptions {
   /// least foot_gap_from h (and foot_gap_from_edges average edges) outwards across the contour.
   double foot_gap_from = 1.0, foot_gap_from_edges = 3;
   double foot_gap_level = 0.05;  ///< the walk stops at a bin below this share of the rise (on the clean blended disk of
-                                 ///< SegmentFootGap, 0.15 read 1 edge for a contour 2.5 edges up the slope)
+                                 ///< SegmentFootGap, 0.15 read 1 edge for a contour 3.3 edges up the slope)
 };
 
 /// One measured contour point.

@@ -79,6 +79,8 @@ struct Options {
   /// the step at least 1.5 edges inside it, outside planes' residual under 5% of h); foot_snap
   /// puts it everywhere (not in the paper).
   bool foot_snap_blended = true;
+  /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
+  bool wall_foot = true;
   /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
