@@ -354,23 +354,14 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                             " left (no clean background outside)");
         a.run.contour = snake.points();
       };
-      // Down the walls, kept only if the contour still bounds the same region: the trace between two
-      // moved snaxels can cut other edges, and on a narrow relief the flood then leaks.
-      auto down_the_walls = [&] {
-        if (!options.wall_foot) return;
-        std::vector<SurfacePoint> moved = a.run.contour;
-        if (settle_down_walls(mesh, &moved, a.region).moved > 0 &&
-            relief_region(mesh, moved, options.closed, inside_left) == a.region)
-          a.run.contour = std::move(moved);
-      };
       if (options.foot_snap) settle_at_the_foot(false);
       a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
-      down_the_walls();
+      if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
       a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length())) {
         settle_at_the_foot(true);
         a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
-        down_the_walls();
+        if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
         a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
       }
       a.evidence.covered_share = covered_share(mesh, enclosure, a.region, h_try, a.evidence.step.step_height);
