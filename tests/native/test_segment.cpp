@@ -177,6 +177,17 @@ INSTANTIATE_TEST_SUITE_P(Synthetic, SegmentScan, ::testing::ValuesIn(cases()),
 
 namespace {
 
+// The disk relief (radius 12, centre 0) with its step blended over 1 h, seven edges per h.
+syn::ScanSpec wide_blended_disk() {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.blend_width = 1.0;
+  spec.h = 3;
+  spec.triangles = 60000;
+  return spec;
+}
+
 // Mean distance of a result's contour from the disk relief's foot circle (radius 12, centre 0).
 double mean_offset_from_foot(const Result& r) {
   double sum = 0;
@@ -199,12 +210,7 @@ Result segment_disk(const syn::Scan& scan, bool foot_snap_blended) {
 // per h) holds the snake part of the way up; the stage brings it down to the foot. On a sharp step
 // the gate stays shut and the contour is the same either way.
 TEST(SegmentFoot, BlendedStepsSettleAtTheFootSharpOnesAreLeftAlone) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;
-  spec.step = syn::Step::Blended;
-  spec.blend_width = 1.0;
-  spec.h = 3;  // seven edges per h
-  spec.triangles = 60000;
+  syn::ScanSpec spec = wide_blended_disk();
   const syn::Scan blended = syn::generate(spec);
   const Result off = segment_disk(blended, false), on = segment_disk(blended, true);
   ASSERT_EQ(on.status, Status::Converged) << on.message;
@@ -250,12 +256,7 @@ TEST(SegmentRefit, AStepFoundAboveHCanBeRefittedSoonerThanOneBelow) {
 // found above h refitted from x1.15 on (refit_ratio_up), the contour comes down towards the foot. The
 // foot stage is off so that only the refit moves it.
 TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwardsFromRefitRatioUp) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;
-  spec.step = syn::Step::Blended;
-  spec.blend_width = 1.0;
-  spec.h = 3;
-  spec.triangles = 60000;
+  const syn::ScanSpec spec = wide_blended_disk();
   const syn::Scan scan = syn::generate(spec);
   const Mesh mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks(syn::PickSpec{});
@@ -292,12 +293,7 @@ double check_value(const Result& r, const std::string& name) {
 // why. At x0.6 the check turns down the attempts up the slope and a larger W_int, then the refit, bring
 // the contour to the foot. At the true h the contour is at the foot and the gap is nil.
 TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Disk;
-  spec.step = syn::Step::Blended;
-  spec.blend_width = 1.0;
-  spec.h = 3;
-  spec.triangles = 60000;
+  const syn::ScanSpec spec = wide_blended_disk();
   const syn::Scan scan = syn::generate(spec);
   const Mesh mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks(syn::PickSpec{});
