@@ -100,9 +100,6 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   const double gap_bin = std::max(edge, radius / 1024);  // one edge (at most 1024 bins across the ball)
   std::vector<std::vector<double>> gap_bins(static_cast<std::size_t>(radius / gap_bin) + 1);
   const double gap_from = std::max(options.foot_gap_from * h, options.foot_gap_from_edges * edge);
-  // Per measured profile: its bins' median heights above its far plane (NaN: an empty bin; no bins:
-  // not measured), for the contour's foot gap.
-  std::vector<std::vector<double>> gap_rows;
   // The foot gap of one profile (StepProfile::foot_gap); inward and tangent as for the front.
   const auto foot_gap = [&](const Vec3& centre, const Vec3& inward, const Vec3& tangent, double rise) {
     far_outside.clear();
@@ -121,12 +118,8 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       const std::size_t b = std::min(gap_bins.size() - 1, static_cast<std::size_t>(across / gap_bin));
       gap_bins[b].push_back((mesh.position(v) - far_plane.centroid).dot(far_plane.normal));
     }
-    std::vector<double>& row = gap_rows.back();
-    row.assign(gap_bins.size(), std::numeric_limits<double>::quiet_NaN());
     for (std::size_t b = 0; b < gap_bins.size(); ++b)
-      if (!gap_bins[b].empty()) row[b] = quantile(gap_bins[b], 0.5);
-    for (std::size_t b = 0; b < gap_bins.size(); ++b)
-      if (!gap_bins[b].empty() && row[b] < level) return b * gap_bin;
+      if (!gap_bins[b].empty() && quantile(gap_bins[b], 0.5) < level) return b * gap_bin;
     return radius;
   };
   for (int k = 0; k < count; ++k) {
@@ -197,11 +190,9 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
         profile.front_measured = true;
         profile.front = quantile(heights, 0.5);
       }
-      gap_rows.emplace_back();
       profile.foot_gap = foot_gap(centre, inward, tangent, profile.rise);
     } else {
       strips.emplace_back();
-      gap_rows.emplace_back();
     }
     evidence.profiles.push_back(profile);
   }
@@ -265,30 +256,6 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       if (p.on_step) gaps.push_back(p.foot_gap);
     evidence.foot_gap_median = quantile(gaps, 0.5);
     evidence.foot_gap_q75 = quantile(gaps, 0.75);
-    // The contour's foot gap: the median over the on-step profiles of each bin's height, walked
-    // outwards to where it falls below the level (foot_gap_level of the step found, and three
-    // standard errors of that median: texture and noise average out along the contour, a slope left
-    // outside does not), the crossing interpolated between bin centres.
-    double previous = std::numeric_limits<double>::quiet_NaN(), previous_at = 0;
-    for (std::size_t b = 0; b < gap_bins.size(); ++b) {
-      std::vector<double> values;
-      for (std::size_t k = 0; k < evidence.profiles.size(); ++k)
-        if (evidence.profiles[k].on_step && b < gap_rows[k].size() && std::isfinite(gap_rows[k][b]))
-          values.push_back(gap_rows[k][b]);
-      if (values.size() < 5) continue;
-      const double median = quantile(values, 0.5);
-      for (double& v : values) v = std::fabs(v - median);
-      const double standard_error = 1.4826 * quantile(values, 0.5) * 1.2533 / std::sqrt(double(values.size()));
-      const double level = std::max(options.foot_gap_level * evidence.step_height, 3 * standard_error);
-      const double at = (b + 0.5) * gap_bin;
-      if (median < level) {
-        evidence.foot_gap_contour =
-            std::isfinite(previous) ? previous_at + (previous - level) / (previous - median) * (at - previous_at) : 0.0;
-        break;
-      }
-      previous = median, previous_at = at;
-      evidence.foot_gap_contour = at;
-    }
     evidence.longest_far = far_run.length * spacing;
   }
   return evidence;

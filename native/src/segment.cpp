@@ -255,19 +255,19 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   bool inside_left = options.closed ? contour_orientation_left(mesh, initial.path)
                                     : options.relief_side != ReliefSide::Right;
   double h = options.step_height;
+  StepHeightEstimate estimate;
   if (!h_given || !side_given) {
-    const StepHeightEstimate estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left);
+    estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left);
     if (!side_given) {
       inside_left = estimate.relief_left;
       result.notes.push_back(std::string("the relief side was decided from the surface: ") +
                              (inside_left ? "left" : "right") + " of the picks (the side that rises)");
     }
     if (!h_given) {
-      if (!(estimate.value > 0))
-        throw Error("could not estimate the step height: nothing rises above the background inside the picked "
-                    "contour; give h (measure the step) or pick around the relief");
-      // Kept within what the mesh can resolve and hold (the self-check judges the rest).
-      h = std::clamp(estimate.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
+      // Kept within what the mesh can resolve and hold (the self-check judges the rest). None
+      // (0): the further guesses below, if any, else an error.
+      h = estimate.value > 0 ? std::clamp(estimate.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4)
+                             : 0.0;
       result.step_height_estimate = h;
       result.step_height_confidence = estimate.confidence;
     }
@@ -507,22 +507,59 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     return best;
   };
 
-  Attempt best = attempt_at(h);
-  std::vector<double> tried = {h};
-  for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && best.usable(); ++refit) {
-    const double found = best.evidence.step.step_height;
-    if (!refit_wanted(found, best.h, tried, options)) break;
-    tried.push_back(found);
-    Attempt next = attempt_at(found);
-    if (cancelled) break;
-    if (better(next, best)) {
-      result.notes.push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(best.h) +
-                             "; segmented again with h = " + fmt(found));
-      best = std::move(next);
-    } else {
-      break;
+  // One h, then the refit along the contour; the notes go to the result if it is kept.
+  std::vector<double> tried;
+  auto attempt_with_refits = [&](double h_first, std::vector<std::string>* notes) {
+    Attempt kept = attempt_at(h_first);
+    tried.push_back(h_first);
+    for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && kept.usable(); ++refit) {
+      const double found = kept.evidence.step.step_height;
+      if (!refit_wanted(found, kept.h, tried, options)) break;
+      tried.push_back(found);
+      Attempt next = attempt_at(found);
+      if (cancelled) break;
+      if (!better(next, kept)) break;
+      notes->push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(kept.h) +
+                       "; segmented again with h = " + fmt(found));
+      kept = std::move(next);
+    }
+    return kept;
+  };
+  std::vector<std::string> h_notes;
+  Attempt best;
+  if (h > 0) best = attempt_with_refits(h, &h_notes);
+  // An estimated h that gives no result (or, with retry_estimate=doubtful, one that fails the
+  // self-check): the estimator's further guesses, each with its refit, the best evidence kept. Guesses within x1.3 of an h tried already
+  // would find the same contour.
+  const bool retry = options.retry_estimate == EstimateRetry::Doubtful ? !(best.usable() && best.check.holds)
+                   : options.retry_estimate == EstimateRetry::NoResult ? !best.usable()
+                                                                        : false;
+  if (!h_given && retry && !cancelled) {
+    for (const StepHeightGuess& guess :
+         alternative_step_heights(mesh, initial.path, options.closed, inside_left, estimate)) {
+      const double g = std::clamp(guess.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
+      bool near_tried = false;
+      for (const double t : tried) near_tried = near_tried || std::fabs(std::log(g / t)) < std::log(options.refit_ratio);
+      if (near_tried) continue;
+      std::vector<std::string> notes = {"the estimated h = " + fmt(h) +
+                                        (best.usable() ? " gave a result that failed the self-check"
+                                                       : " gave no result (the snake collapsed)") +
+                                        "; segmented again with h = " + fmt(g) + " (" + guess.source + ")"};
+      if (!(h > 0)) notes.front() = "h = " + fmt(g) + " estimated from " + guess.source;
+      Attempt next = attempt_with_refits(g, &notes);
+      if (cancelled) break;
+      if (!best.usable() || better(next, best)) {
+        best = std::move(next);
+        h_notes = std::move(notes);
+        if (!(h > 0)) h = g, result.step_height_estimate = g;
+      }
+      if (best.usable() && best.check.holds) break;
     }
   }
+  if (!h_given && !(h > 0))
+    throw Error("could not estimate the step height: nothing rises above the background inside the picked "
+                "contour; give h (measure the step) or pick around the relief");
+  for (std::string& n : h_notes) result.notes.push_back(std::move(n));
   if (cancelled) {
     Result out;
     out.status = Status::Cancelled;
@@ -603,7 +640,6 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"far_run", step.longest_far / best.h},
                    {"foot_gap_median", step.foot_gap_median / best.h},
                    {"foot_gap_q75", step.foot_gap_q75 / best.h},
-                   {"foot_gap_contour", step.foot_gap_contour / best.h},
                    {"background_depth", best.evidence.background_depth},
                    {"background_area", best.evidence.background_area}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});

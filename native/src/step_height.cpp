@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "relief_snake/background.hpp"
 #include "relief_snake/height_statistics.hpp"
 #include "relief_snake/region.hpp"
 
@@ -83,7 +84,7 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   } else {
     // The relief is on the side that rises above the background, compared over a strip
     // along the contour (a tenth of its length wide) where the fit can be trusted.
-    const std::vector<char> near = near_samples(mesh, samples, 0.1 * path_length(mesh, path, false));
+    const std::vector<char> near = near_samples(mesh, samples, options.strip_share * path_length(mesh, path, false));
     const auto left = heights_of(mesh, relief_region(mesh, path, false, true), background, &near);
     const auto right = heights_of(mesh, relief_region(mesh, path, false, false), background, &near);
     estimate.left_rise = weighted_quantile(left, 0.9);
@@ -108,6 +109,66 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   const double size = path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
   if (value > 0.25 * size) estimate.confidence = 0;
   return estimate;
+}
+
+namespace {
+
+// The median and the 90% height of the heights' upper Otsu class (none when they are not > 0).
+void relief_group_guesses(const std::vector<WeightedHeight>& heights, const StepHeightOptions& options,
+                          const std::string& source, std::vector<StepHeightGuess>* out) {
+  if (heights.empty()) return;
+  const OtsuSplit split = otsu_split(heights, options.histogram_bins);
+  std::vector<WeightedHeight> relief;
+  for (const auto& v : heights)
+    if (v.height > split.threshold) relief.push_back(v);
+  const double median = weighted_quantile(relief, 0.5), high = weighted_quantile(relief, 0.9);
+  if (median > 0 && std::isfinite(median)) out->push_back({median, "the median height of the relief over " + source});
+  if (high > 0 && std::isfinite(high)) out->push_back({high, "the 90% height of the relief over " + source});
+}
+
+}  // namespace
+
+std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const SurfacePath& path, bool closed,
+                                                      bool relief_left, const StepHeightEstimate& first,
+                                                      const StepHeightOptions& options) {
+  std::vector<StepHeightGuess> out;
+  if (path.size() < 2) return out;
+  // A step a sizeable part of the contour's own size is no relief step (as for the first estimate,
+  // whose confidence it zeroes): such a guess is the background's own curvature.
+  const double size = path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
+  const auto plausible = [&] {
+    out.erase(std::remove_if(out.begin(), out.end(), [&](const StepHeightGuess& g) { return g.value > 0.25 * size; }),
+              out.end());
+    return out;
+  };
+  if (closed) {
+    // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot; cotangent
+    // weights can be singular over a sharp wall's projection, uniform ones are not.
+    const std::vector<char> region = relief_region(mesh, path, true, relief_left);
+    const double scale = options.fill_scale_edges * mesh.average_edge_length();
+    BackgroundResult fill = BackgroundSolver(mesh).solve(region, scale);
+    if (!fill.ok()) {
+      BackgroundOptions uniform;
+      uniform.laplacian = BackgroundLaplacian::Uniform;
+      fill = BackgroundSolver(mesh, uniform).solve(region, scale);
+    }
+    if (!fill.ok()) return out;
+    std::vector<WeightedHeight> heights;
+    heights.reserve(fill.region_vertices.size());
+    for (const int v : fill.region_vertices) heights.push_back({fill.height[v], mesh.vertex_area(v)});
+    relief_group_guesses(heights, options, "the background filled in from around the picks", &out);
+    return plausible();
+  } else {
+    const std::vector<int> samples = contour_band_vertices(mesh, path, options.band_rings);
+    const QuadraticBackground background = fit_background(mesh, samples);
+    const std::vector<char> near =
+        near_samples(mesh, samples, options.wide_strip_share * path_length(mesh, path, false));
+    relief_group_guesses(heights_of(mesh, relief_region(mesh, path, false, relief_left), background, &near), options,
+                         "a wider strip along the picks", &out);
+    const double side_rise = relief_left ? first.left_rise : first.right_rise;
+    if (side_rise > 0) out.push_back({side_rise, "the 90% height of the relief side along the picks"});
+  }
+  return plausible();
 }
 
 }  // namespace relief_snake

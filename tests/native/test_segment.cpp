@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "relief_snake/error.hpp"
 #include "relief_snake/segment.hpp"
 #include "synthetic.hpp"
 
@@ -351,4 +352,35 @@ TEST(SegmentWall, SnaxelsOnATallSharpWallMoveDownToItsFoot) {
   EXPECT_LT(mean_height(down), 0.1 * edge);
   EXPECT_GT(mean_height(up), 0.15 * edge);
   EXPECT_EQ(down.relief_vertices, up.relief_vertices);
+}
+
+// With h estimated, when the first estimate gives no result the scan is segmented again at the
+// estimator's further guesses (retry_estimate, step_height.hpp). Random scan 115 is a blended
+// ellipse over most of a vase's swell (1.7 edges per h): the quadric along the picks cannot follow
+// the swell and puts h at about x7, where the coarse snake collapses; the thin-plate fill of the
+// background brings h within a third and the result converges on the relief.
+TEST(SegmentEstimate, FurtherGuessesOfHWhenTheFirstEstimateFails) {
+  const syn::RandomScan random = syn::generate_random(115);
+  const syn::Scan& scan = random.scan;
+  const Mesh mesh = syn::to_mesh(scan);
+  Options options;  // step_height 0: estimated
+  options.closed = random.picks.closed;
+  const Result result = segment(mesh, random.picks.vertices, options);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  EXPECT_NEAR(result.parameters.step_height, scan.h, 0.33 * scan.h);
+  EXPECT_GT(result.step_height_estimate, 0.0);
+  bool retried = false;
+  for (const std::string& n : result.notes) retried = retried || n.find("gave no result (the snake collapsed); segmented again") != std::string::npos;
+  EXPECT_TRUE(retried);
+  syn::Polyline contour;
+  contour.points = result.polyline;
+  contour.closed = result.closed;
+  const syn::Score s = syn::score(contour, result.relief_vertices, scan);
+  EXPECT_GE(s.iou, 0.95);
+  EXPECT_LE(s.mean_to_truth, 1.0);
+  EXPECT_LE(s.mean_from_truth, 1.0);
+
+  Options first_only = options;
+  first_only.retry_estimate = EstimateRetry::Off;
+  EXPECT_THROW(segment(mesh, random.picks.vertices, first_only), Error);
 }

@@ -11,6 +11,9 @@ it with an h typed anywhere from x0.5 to x2.0 of the true step. The contract:
 
 The benchmark's target is 97% accurate on the 200-scan suite; on 20 scans one failure already costs
 5%, so this sample asks for 18 of 20.
+
+The same twenty scans are also segmented with `--step-height auto` (h estimated, the engine's default
+mode), held to what was measured there (test_auto_h_no_worse_than_measured).
 """
 import json
 import sys
@@ -24,23 +27,32 @@ SEEDS = "1000:1020"
 MIN_ACCURATE = 0.9
 
 
-@pytest.fixture(scope="module")
-def sample(build_dir, tmp_path_factory):
+def run_sample(build_dir, out, variant):
     sys.path.insert(0, str(REPO_ROOT))
     from bench import random_suite
 
-    out = tmp_path_factory.mktemp("random-suite")
     for exe in ("relief-snake", "make-scan"):
         if not (build_dir / exe).is_file():
             pytest.fail(f"{build_dir / exe} not found: build the relief-snake and make-scan targets")
     code = random_suite.main(["--cli", str(build_dir / "relief-snake"), "--make-scan", str(build_dir / "make-scan"),
-                              "--seeds", SEEDS, "--jobs", "2", "--variant", "defaults", "--real-scan", "",
+                              "--seeds", SEEDS, "--jobs", "2", "--variant", variant, "--real-scan", "",
                               "--timeout", "60", "--out", str(out)])
     assert code == 0
     data = json.loads((out / "results.json").read_text())
-    rows = data["rows"]["defaults"]
+    rows = data["rows"][variant]
     assert len(rows) == 20
     return rows
+
+
+@pytest.fixture(scope="module")
+def sample(build_dir, tmp_path_factory):
+    return run_sample(build_dir, tmp_path_factory.mktemp("random-suite"), "defaults")
+
+
+@pytest.fixture(scope="module")
+def auto_h_sample(build_dir, tmp_path_factory):
+    """The same scans with h left to the engine (`--step-height auto`, the default mode)."""
+    return run_sample(build_dir, tmp_path_factory.mktemp("random-suite-auto-h"), "auto-h")
 
 
 def describe(row):
@@ -84,3 +96,18 @@ def test_no_worse_than_measured(sample):
     assert accurate >= MEASURED_ACCURATE and len(silent) <= MEASURED_SILENT, (
         f"{accurate} of {len(sample)} accurate (measured {MEASURED_ACCURATE}), {len(silent)} silent "
         f"(measured {MEASURED_SILENT}):\n" + "\n".join(describe(r) for r in silent))
+
+
+# With h estimated the sample is not yet free of silent failures: seeds 1003 and 1014 come back wrong
+# and `converged` (3 December 2026, as before the estimate's further guesses). This guards against
+# regressions until the contract above holds for it too.
+MEASURED_AUTO_H_ACCURATE = 17
+MEASURED_AUTO_H_SILENT = 2
+
+
+def test_auto_h_no_worse_than_measured(auto_h_sample):
+    accurate = sum(r["accurate"] for r in auto_h_sample)
+    silent = [r for r in auto_h_sample if not r["accurate"] and not r["flagged"]]
+    assert accurate >= MEASURED_AUTO_H_ACCURATE and len(silent) <= MEASURED_AUTO_H_SILENT, (
+        f"{accurate} of {len(auto_h_sample)} accurate (measured {MEASURED_AUTO_H_ACCURATE}), {len(silent)} silent "
+        f"(measured {MEASURED_AUTO_H_SILENT}):\n" + "\n".join(describe(r) for r in silent))

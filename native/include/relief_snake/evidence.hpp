@@ -84,10 +84,6 @@ struct StepEvidence {
   double longest_far = 0;             ///< longest run of such profiles, as contour length
   int far_point = -1;                 ///< contour index in the middle of that run (-1: none)
   double foot_gap_median = 0, foot_gap_q75 = 0;  ///< of the on-step profiles' foot gaps (mesh units)
-  /// The contour's foot gap: the walk over the median, bin by bin, of the on-step profiles' bins,
-  /// against the level or three standard errors of that median (texture and noise average out along
-  /// the contour, a slope left outside does not), the crossing interpolated (mesh units).
-  double foot_gap_contour = 0;
   double average_edge = 0;            ///< the mesh's, for the checks measured in edges
   double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
 };
