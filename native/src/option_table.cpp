@@ -167,10 +167,12 @@ const std::vector<Row>& rows() {
              "refit h when the step found and h differ by more than this factor"),
       number("refit_ratio_up", &Options::refit_ratio_up, "> 1", [](double x) { return x > 1; },
              "refit h already when the step found exceeds h by this factor (at most refit_ratio)"),
-      choice("retry_estimate", &Options::retry_estimate, "off, no_result or doubtful",
-             {{"off", EstimateRetry::Off}, {"no_result", EstimateRetry::NoResult}, {"doubtful", EstimateRetry::Doubtful}},
+      choice("retry_estimate", &Options::retry_estimate, "off, no_result, doubtful_flagged or doubtful",
+             {{"off", EstimateRetry::Off}, {"no_result", EstimateRetry::NoResult},
+              {"doubtful_flagged", EstimateRetry::DoubtfulFlagged}, {"doubtful", EstimateRetry::Doubtful}},
              "with h estimated: segment again at the estimator's further guesses of h when the first estimate "
-             "gives no result (no_result) or also a doubtful one (doubtful), keeping the best evidence (not in the paper)"),
+             "gives no result (no_result), or also a doubtful one (doubtful_flagged: what comes of it stays "
+             "doubtful; doubtful: its own verdict stands), keeping the best evidence (not in the paper)"),
       boolean("foot_snap", &Options::foot_snap,
               "after stabilisation, move the contour out to the foot of the step, where the surface leaves "
               "the background (not in the paper)"),

@@ -531,9 +531,16 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   // An estimated h that gives no result (or, with retry_estimate=doubtful, one that fails the
   // self-check): the estimator's further guesses, each with its refit, the best evidence kept. Guesses within x1.3 of an h tried already
   // would find the same contour.
-  const bool retry = options.retry_estimate == EstimateRetry::Doubtful ? !(best.usable() && best.check.holds)
-                   : options.retry_estimate == EstimateRetry::NoResult ? !best.usable()
-                                                                        : false;
+  const bool retry_doubtful = options.retry_estimate == EstimateRetry::Doubtful ||
+                              options.retry_estimate == EstimateRetry::DoubtfulFlagged;
+  const bool retry = options.retry_estimate != EstimateRetry::Off &&
+                     (!best.usable() || (retry_doubtful && !best.check.holds));
+  // doubtful_flagged: a result kept from a further guess after the first estimate's failed its
+  // self-check is reported doubtful with this reason (each guess is one more chance for a wrong
+  // contour to pass).
+  std::string second_guess_reason;
+  const std::string first_failure =
+      best.usable() && !best.check.reasons.empty() ? best.check.reasons.front() : std::string();
   if (!h_given && retry && !cancelled) {
     for (const StepHeightGuess& guess :
          alternative_step_heights(mesh, initial.path, options.closed, inside_left, estimate)) {
@@ -549,6 +556,10 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       Attempt next = attempt_with_refits(g, &notes);
       if (cancelled) break;
       if (!best.usable() || better(next, best)) {
+        if (options.retry_estimate == EstimateRetry::DoubtfulFlagged && !first_failure.empty())
+          second_guess_reason = "h was guessed again: at the first estimate (" + fmt(h) +
+                                ") the result failed the self-check (" + first_failure + "); this one, at h = " +
+                                fmt(next.h) + ", passes it only as a further guess";
         best = std::move(next);
         h_notes = std::move(notes);
         if (!(h > 0)) h = g, result.step_height_estimate = g;
@@ -644,6 +655,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"background_area", best.evidence.background_area}});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
+  if (!second_guess_reason.empty() && result.reasons.empty()) result.reasons.push_back(second_guess_reason);
   if (options.closed) {
     // Picks on one side of the relief can still leave a snake that settles on something. Judged
     // with the step found along the contour where it is lower than h (a rough h given too large,

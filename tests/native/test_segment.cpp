@@ -384,3 +384,30 @@ TEST(SegmentEstimate, FurtherGuessesOfHWhenTheFirstEstimateFails) {
   first_only.retry_estimate = EstimateRetry::Off;
   EXPECT_THROW(segment(mesh, random.picks.vertices, first_only), Error);
 }
+
+// retry_estimate=doubtful also guesses h again when the first estimate's result fails its self-check,
+// and trusts the verdict of the guess kept; doubtful_flagged (the default) keeps the same contour but
+// reports it doubtful, saying why. Random scan 44 (a band on a sphere, picked far from it): the first estimate is
+// x0.13 and its result fails; a further guess passes.
+TEST(SegmentEstimate, AGuessKeptAfterAFailedFirstEstimateStaysDoubtful) {
+  const syn::RandomScan random = syn::generate_random(44);
+  const Mesh mesh = syn::to_mesh(random.scan);
+  Options options;
+  options.closed = random.picks.closed;
+  options.retry_estimate = EstimateRetry::Doubtful;
+  const Result trusted = segment(mesh, random.picks.vertices, options);
+  options.retry_estimate = EstimateRetry::DoubtfulFlagged;
+  EXPECT_EQ(Options().retry_estimate, EstimateRetry::DoubtfulFlagged);
+  const Result flagged = segment(mesh, random.picks.vertices, options);
+  ASSERT_EQ(trusted.status, Status::Converged) << trusted.message;
+  EXPECT_EQ(flagged.status, Status::Doubtful);
+  ASSERT_EQ(flagged.reasons.size(), 1u);
+  EXPECT_NE(flagged.reasons.front().find("h was guessed again"), std::string::npos) << flagged.reasons.front();
+  EXPECT_EQ(flagged.polyline, trusted.polyline);
+  EXPECT_EQ(flagged.parameters.step_height, trusted.parameters.step_height);
+  syn::Polyline contour;
+  contour.points = trusted.polyline;
+  contour.closed = trusted.closed;
+  const syn::Score s = syn::score(contour, trusted.relief_vertices, random.scan);
+  EXPECT_GE(s.iou, 0.95);
+}
