@@ -189,6 +189,15 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   EXPECT_TRUE(judge(e, 1.0).holds);
 }
 
+// A blended step beside a flat band running off the mesh (an open contour's scan).
+static syn::Scan blended_open_scan() {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Open;
+  spec.step = syn::Step::Blended;
+  spec.triangles = 60000;
+  return syn::generate(spec);
+}
+
 TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {
   for (const auto background : {syn::Background::Plane, syn::Background::Cylinder, syn::Background::Sphere})
     for (const auto step : {syn::Step::Sharp, syn::Step::Blended})
@@ -207,11 +216,7 @@ TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {
 }
 
 TEST(StepHeight, OpenContoursFindTheSideThatRises) {
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Open;
-  spec.step = syn::Step::Blended;
-  spec.triangles = 60000;
-  const syn::Scan scan = syn::generate(spec);
+  const syn::Scan scan = blended_open_scan();
   const Mesh mesh = syn::to_mesh(scan);
   for (const bool reverse : {false, true}) {
     syn::PickSpec ps;
@@ -250,11 +255,7 @@ TEST(StepHeight, FurtherGuessesFollowTheBackgroundTheQuadricMisses) {
 
   // Open: on the flat band beside a blended step, every guess is positive and the wide strip's
   // median is near h.
-  syn::ScanSpec spec;
-  spec.shape = syn::Shape::Open;
-  spec.step = syn::Step::Blended;
-  spec.triangles = 60000;
-  const syn::Scan scan = syn::generate(spec);
+  const syn::Scan scan = blended_open_scan();
   const Mesh open_mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks();
   std::vector<int> open_vertices(picks.vertices.begin(), picks.vertices.end());

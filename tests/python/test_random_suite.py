@@ -90,12 +90,16 @@ MEASURED_ACCURATE = 17
 MEASURED_SILENT = 0
 
 
+def assert_no_worse(rows, measured_accurate, measured_silent):
+    accurate = sum(r["accurate"] for r in rows)
+    silent = [r for r in rows if not r["accurate"] and not r["flagged"]]
+    assert accurate >= measured_accurate and len(silent) <= measured_silent, (
+        f"{accurate} of {len(rows)} accurate (measured {measured_accurate}), {len(silent)} silent "
+        f"(measured {measured_silent}):\n" + "\n".join(describe(r) for r in silent))
+
+
 def test_no_worse_than_measured(sample):
-    accurate = sum(r["accurate"] for r in sample)
-    silent = [r for r in sample if not r["accurate"] and not r["flagged"]]
-    assert accurate >= MEASURED_ACCURATE and len(silent) <= MEASURED_SILENT, (
-        f"{accurate} of {len(sample)} accurate (measured {MEASURED_ACCURATE}), {len(silent)} silent "
-        f"(measured {MEASURED_SILENT}):\n" + "\n".join(describe(r) for r in silent))
+    assert_no_worse(sample, MEASURED_ACCURATE, MEASURED_SILENT)
 
 
 # With h estimated the sample is not yet free of silent failures: seeds 1003 and 1014 come back wrong
@@ -106,8 +110,4 @@ MEASURED_AUTO_H_SILENT = 2
 
 
 def test_auto_h_no_worse_than_measured(auto_h_sample):
-    accurate = sum(r["accurate"] for r in auto_h_sample)
-    silent = [r for r in auto_h_sample if not r["accurate"] and not r["flagged"]]
-    assert accurate >= MEASURED_AUTO_H_ACCURATE and len(silent) <= MEASURED_AUTO_H_SILENT, (
-        f"{accurate} of {len(auto_h_sample)} accurate (measured {MEASURED_AUTO_H_ACCURATE}), {len(silent)} silent "
-        f"(measured {MEASURED_AUTO_H_SILENT}):\n" + "\n".join(describe(r) for r in silent))
+    assert_no_worse(auto_h_sample, MEASURED_AUTO_H_ACCURATE, MEASURED_AUTO_H_SILENT)
