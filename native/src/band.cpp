@@ -310,7 +310,7 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
     std::string message = result.status == Status::IterationCap ? "The snakes did not settle: " : "Check this result: ";
     for (std::size_t k = 0; k < result.reasons.size(); ++k) message += (k ? "; " : "") + result.reasons[k];
     message += ". Try pick rings closer beside the band";
-    if (h_given) message += ", or a different step height";
+    message += h_given ? ", or a different step height" : ", or give the step height";
     result.message = message + ".";
   }
   if (!h_given) {

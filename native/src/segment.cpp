@@ -686,7 +686,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     std::string message = result.status == Status::IterationCap ? "The snake did not settle: " : "Check this result: ";
     for (std::size_t k = 0; k < result.reasons.size(); ++k) message += (k ? "; " : "") + result.reasons[k];
     message += ". Try picks closer around the relief";
-    if (h_given) message += ", or a different step height";
+    // With h estimated, giving it is the other remedy (the estimate, or a further guess of it, may be off).
+    message += h_given ? ", or a different step height" : ", or give the step height";
     message += ".";
     result.message = message;
   }
