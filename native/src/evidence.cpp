@@ -73,10 +73,10 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
                           const std::vector<char>& region, double h, const EvidenceOptions& options) {
   StepEvidence evidence;
   if (contour.empty() || h <= 0) return evidence;
-  evidence.average_edge = mesh.average_edge_length();
   const int n = static_cast<int>(contour.size());
   const int count = std::min(n, std::max(1, options.max_profiles));
   const double edge = mesh.average_edge_length();
+  evidence.average_edge = edge;
   const double radius = std::max(options.radius * h, options.min_radius_edges * edge);
   const double exclude = std::max(options.outside_from * h, edge);
   const double exclude2 = exclude * exclude;

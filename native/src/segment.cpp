@@ -255,6 +255,10 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   bool inside_left = options.closed ? contour_orientation_left(mesh, initial.path)
                                     : options.relief_side != ReliefSide::Right;
   double h = options.step_height;
+  // An estimated h, kept within what the mesh can resolve and hold (the self-check judges the rest).
+  const auto resolvable = [&](double estimated) {
+    return std::clamp(estimated, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
+  };
   StepHeightEstimate estimate;
   if (!h_given || !side_given) {
     estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left);
@@ -264,10 +268,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                              (inside_left ? "left" : "right") + " of the picks (the side that rises)");
     }
     if (!h_given) {
-      // Kept within what the mesh can resolve and hold (the self-check judges the rest). None
-      // (0): the further guesses below, if any, else an error.
-      h = estimate.value > 0 ? std::clamp(estimate.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4)
-                             : 0.0;
+      // None (0): the further guesses below, if any, else an error.
+      h = estimate.value > 0 ? resolvable(estimate.value) : 0.0;
       result.step_height_estimate = h;
       result.step_height_confidence = estimate.confidence;
     }
@@ -354,15 +356,17 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                             " left (no clean background outside)");
         a.run.contour = snake.points();
       };
-      if (options.foot_snap) settle_at_the_foot(false);
-      a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
-      if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
-      a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
-      if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length())) {
-        settle_at_the_foot(true);
+      // The region the contour cuts, the snaxels on a sharp wall moved down it, the step measured.
+      auto region_and_step = [&] {
         a.region = relief_region(mesh, a.run.contour, options.closed, inside_left);
         if (options.wall_foot) settle_down_walls(mesh, &a.run.contour, a.region);
         a.evidence.step = measure_step(mesh, a.run.contour, a.region, h_try, evidence_options);
+      };
+      if (options.foot_snap) settle_at_the_foot(false);
+      region_and_step();
+      if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length())) {
+        settle_at_the_foot(true);
+        region_and_step();
       }
       a.evidence.covered_share = covered_share(mesh, enclosure, a.region, h_try, a.evidence.step.step_height);
       a.evidence.coarse_step_share = coarse_step_share;
@@ -528,12 +532,12 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   std::vector<std::string> h_notes;
   Attempt best;
   if (h > 0) best = attempt_with_refits(h, &h_notes);
-  // An estimated h that gives no result (or, with retry_estimate=doubtful, one that fails the
-  // self-check): the estimator's further guesses, each with its refit, the best evidence kept. Guesses within x1.3 of an h tried already
-  // would find the same contour.
+  // An estimated h that gives no result (or, unless retry_estimate=no_result, one that fails the
+  // self-check): the estimator's further guesses, each with its refit, the best evidence kept.
+  // Guesses within x1.3 of an h tried already would find the same contour.
   const bool retry_doubtful = options.retry_estimate == EstimateRetry::Doubtful ||
                               options.retry_estimate == EstimateRetry::DoubtfulFlagged;
-  const bool retry = options.retry_estimate != EstimateRetry::Off &&
+  const bool retry = !h_given && options.retry_estimate != EstimateRetry::Off &&
                      (!best.usable() || (retry_doubtful && !best.check.holds));
   // doubtful_flagged: a result kept from a further guess after the first estimate's failed its
   // self-check is reported doubtful with this reason (each guess is one more chance for a wrong
@@ -541,10 +545,10 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   std::string second_guess_reason;
   const std::string first_failure =
       best.usable() && !best.check.reasons.empty() ? best.check.reasons.front() : std::string();
-  if (!h_given && retry && !cancelled) {
+  if (retry && !cancelled) {
     for (const StepHeightGuess& guess :
          alternative_step_heights(mesh, initial.path, options.closed, inside_left, estimate)) {
-      const double g = std::clamp(guess.value, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
+      const double g = resolvable(guess.value);
       bool near_tried = false;
       for (const double t : tried) near_tried = near_tried || std::fabs(std::log(g / t)) < std::log(options.refit_ratio);
       if (near_tried) continue;

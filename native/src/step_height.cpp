@@ -47,6 +47,33 @@ std::vector<char> near_samples(const Mesh& mesh, const std::vector<int>& samples
   return near;
 }
 
+// The heights' upper class at Otsu's threshold (the relief, over the background near zero).
+std::vector<WeightedHeight> upper_class(const std::vector<WeightedHeight>& heights, int bins,
+                                        OtsuSplit* split_out = nullptr) {
+  const OtsuSplit split = otsu_split(heights, bins);
+  if (split_out) *split_out = split;
+  std::vector<WeightedHeight> relief;
+  for (const auto& v : heights)
+    if (v.height > split.threshold) relief.push_back(v);
+  return relief;
+}
+
+// A contour's size, against which a step a sizeable part of it is no relief step (the background's
+// own curvature): its length over pi (closed) or 2 (open).
+double contour_size(const Mesh& mesh, const SurfacePath& path, bool closed) {
+  return path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
+}
+
+// The median and the 90% height of the heights' upper Otsu class (none when they are not > 0).
+void relief_group_guesses(const std::vector<WeightedHeight>& heights, const StepHeightOptions& options,
+                          const std::string& source, std::vector<StepHeightGuess>* out) {
+  if (heights.empty()) return;
+  const std::vector<WeightedHeight> relief = upper_class(heights, options.histogram_bins);
+  const double median = weighted_quantile(relief, 0.5), high = weighted_quantile(relief, 0.9);
+  if (median > 0 && std::isfinite(median)) out->push_back({median, "the median height of the relief over " + source});
+  if (high > 0 && std::isfinite(high)) out->push_back({high, "the 90% height of the relief over " + source});
+}
+
 }  // namespace
 
 std::vector<int> contour_band_vertices(const Mesh& mesh, const SurfacePath& path, int rings) {
@@ -94,11 +121,8 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   }
   if (heights.empty()) return estimate;
 
-  const OtsuSplit split = otsu_split(heights, options.histogram_bins);
-  std::vector<WeightedHeight> relief;
-  for (const auto& v : heights)
-    if (v.height > split.threshold) relief.push_back(v);
-  const double value = weighted_quantile(relief, 0.5);
+  OtsuSplit split;
+  const double value = weighted_quantile(upper_class(heights, options.histogram_bins, &split), 0.5);
   if (!(value > 0) || !std::isfinite(value)) return estimate;
   estimate.value = value;
   // Sure when the heights split cleanly and the relief stands well above the fit's residual.
@@ -106,41 +130,15 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   const double above_noise = std::clamp(value / (10 * background.residual + 1e-300) , 0.0, 1.0);
   estimate.confidence = clean * above_noise;
   // A step a sizeable part of the contour's own size is no relief step: unsure.
-  const double size = path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
-  if (value > 0.25 * size) estimate.confidence = 0;
+  if (value > 0.25 * contour_size(mesh, path, closed)) estimate.confidence = 0;
   return estimate;
 }
-
-namespace {
-
-// The median and the 90% height of the heights' upper Otsu class (none when they are not > 0).
-void relief_group_guesses(const std::vector<WeightedHeight>& heights, const StepHeightOptions& options,
-                          const std::string& source, std::vector<StepHeightGuess>* out) {
-  if (heights.empty()) return;
-  const OtsuSplit split = otsu_split(heights, options.histogram_bins);
-  std::vector<WeightedHeight> relief;
-  for (const auto& v : heights)
-    if (v.height > split.threshold) relief.push_back(v);
-  const double median = weighted_quantile(relief, 0.5), high = weighted_quantile(relief, 0.9);
-  if (median > 0 && std::isfinite(median)) out->push_back({median, "the median height of the relief over " + source});
-  if (high > 0 && std::isfinite(high)) out->push_back({high, "the 90% height of the relief over " + source});
-}
-
-}  // namespace
 
 std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const SurfacePath& path, bool closed,
                                                       bool relief_left, const StepHeightEstimate& first,
                                                       const StepHeightOptions& options) {
   std::vector<StepHeightGuess> out;
   if (path.size() < 2) return out;
-  // A step a sizeable part of the contour's own size is no relief step (as for the first estimate,
-  // whose confidence it zeroes): such a guess is the background's own curvature.
-  const double size = path_length(mesh, path, closed) / (closed ? M_PI : 2.0);
-  const auto plausible = [&] {
-    out.erase(std::remove_if(out.begin(), out.end(), [&](const StepHeightGuess& g) { return g.value > 0.25 * size; }),
-              out.end());
-    return out;
-  };
   if (closed) {
     // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot; cotangent
     // weights can be singular over a sharp wall's projection, uniform ones are not.
@@ -157,7 +155,6 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
     heights.reserve(fill.region_vertices.size());
     for (const int v : fill.region_vertices) heights.push_back({fill.height[v], mesh.vertex_area(v)});
     relief_group_guesses(heights, options, "the background filled in from around the picks", &out);
-    return plausible();
   } else {
     const std::vector<int> samples = contour_band_vertices(mesh, path, options.band_rings);
     const QuadraticBackground background = fit_background(mesh, samples);
@@ -168,7 +165,12 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
     const double side_rise = relief_left ? first.left_rise : first.right_rise;
     if (side_rise > 0) out.push_back({side_rise, "the 90% height of the relief side along the picks"});
   }
-  return plausible();
+  // A step a sizeable part of the contour's own size is the background's own curvature (as for the
+  // first estimate, whose confidence it zeroes).
+  const double size = contour_size(mesh, path, closed);
+  out.erase(std::remove_if(out.begin(), out.end(), [&](const StepHeightGuess& g) { return g.value > 0.25 * size; }),
+            out.end());
+  return out;
 }
 
 }  // namespace relief_snake

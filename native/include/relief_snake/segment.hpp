@@ -20,10 +20,10 @@ const char* to_string(ReliefSide side);
 
 /// Options::holes: look for background islands inside a closed relief (holes.hpp), or not.
 enum class HoleMode { Auto, Off };
+const char* to_string(HoleMode mode);
 
 /// When an estimated h is guessed again (Options::retry_estimate).
 enum class EstimateRetry { Off, NoResult, DoubtfulFlagged, Doubtful };
-const char* to_string(HoleMode mode);
 
 /// Options::step_height and Options::w_int: let the engine choose.
 constexpr double kAuto = 0.0;
