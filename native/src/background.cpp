@@ -510,6 +510,15 @@ BackgroundResult BackgroundSolver::solve(const std::vector<char>& region_in, dou
   return r;
 }
 
+BackgroundResult fill_background(const Mesh& mesh, const std::vector<char>& region, double h,
+                                 const BackgroundOptions& options) {
+  BackgroundResult fill = BackgroundSolver(mesh, options).solve(region, h);
+  if (fill.ok() || options.laplacian == BackgroundLaplacian::Uniform) return fill;
+  BackgroundOptions uniform = options;
+  uniform.laplacian = BackgroundLaplacian::Uniform;
+  return BackgroundSolver(mesh, uniform).solve(region, h);
+}
+
 std::vector<double> height_above(const Mesh& mesh, const BackgroundResult& result,
                                  const std::vector<SurfacePoint>& points) {
   std::vector<double> heights(points.size(), 0.0);

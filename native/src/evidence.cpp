@@ -60,6 +60,18 @@ double region_area(const Mesh& mesh, const std::vector<char>& region) {
   return area;
 }
 
+double kept_relief_share(const Mesh& mesh, const BackgroundResult& fill, const std::vector<char>& region,
+                         double rise) {
+  if (!fill.ok() || region.size() != static_cast<std::size_t>(mesh.n_vertices())) return -1;
+  double relief = 0, kept = 0;
+  for (const int v : fill.region_vertices)
+    if (fill.height[v] >= rise) {
+      relief += mesh.vertex_area(v);
+      if (region[v]) kept += mesh.vertex_area(v);
+    }
+  return relief > 0 ? kept / relief : -1.0;
+}
+
 double region_iou(const Mesh& mesh, const std::vector<char>& a, const std::vector<char>& b) {
   double both = 0, either = 0;
   for (int v = 0; v < mesh.n_vertices(); ++v) {
@@ -336,7 +348,11 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
   // A coarse contour that sat on a step and a refinement that left it far behind: the
   // deflation carried the snake across the step. (A coarse contour still on the
   // background, from picks far out, may rightly be left behind.)
-  if (all.coarse_step_share >= options.min_step_share && all.coarse_iou < options.min_coarse_iou)
+  // A refinement that let go of background only (a bridged concavity) is not one that crossed.
+  const bool coarse_left =
+      all.coarse_step_share >= options.min_step_share && all.coarse_iou < options.min_coarse_iou &&
+      !(all.coarse_relief_kept >= options.min_coarse_relief_kept);
+  if (coarse_left)
     check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(all.coarse_iou) +
                             ": refinement moved far from where the step was first found");
   if (all.abandoned_area_share >= 0)
@@ -362,7 +378,9 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("the surface keeps rising for about " +
                             number(evidence.foot_gap_median / evidence.average_edge) +
                             " average edges outside the contour: it runs partway up the step (h may be too small)");
-  const double coarse_iou = all.coarse_step_share >= options.min_step_share ? all.coarse_iou : 1.0;
+  const double coarse_iou = all.coarse_step_share < options.min_step_share ? 1.0
+                            : all.coarse_relief_kept >= 0 ? std::max(all.coarse_iou, all.coarse_relief_kept)
+                                                          : all.coarse_iou;
   check.holds = check.reasons.empty();
   // Prefer evidence that holds; then more of the contour on a step, a region that agrees
   // with the coarse phase, and a step that agrees with h.

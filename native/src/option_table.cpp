@@ -178,6 +178,9 @@ const std::vector<Row>& rows() {
               "the background (not in the paper)"),
       boolean("wall_foot", &Options::wall_foot,
               "move snaxels resting on a sharp step's tall wall down to its foot (not in the paper)"),
+      boolean("coarse_relief_kept", &Options::coarse_relief_kept,
+              "self-check: a refined region far from the coarse contour's is doubtful only if it lost the "
+              "coarse region's relief, not background the coarse contour bridged (not in the paper)"),
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),

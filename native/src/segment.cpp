@@ -289,10 +289,25 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   EvidenceOptions evidence_options;
   evidence_options.closed = options.closed;
 
+  double preprocess_seconds = 0, background_seconds = 0;
+  // The region-wide check (background_inside.hpp) of an attempt's region, into its evidence.
+  auto measure_region_wide = [&](Attempt& a) {
+    if (!cache_->background_inside) cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh);
+    a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / a.h;
+    BackgroundInside inside = cache_->background_inside->measure(
+        a.region, a.h, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * a.h);
+    background_seconds += inside.seconds;
+    a.evidence.region_checked = inside.checked;
+    a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;
+    a.evidence.background_depth = inside.depth / a.h;
+    a.evidence.background_area = inside.area / (a.h * a.h);
+    if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.to_file(mesh.position(inside.deepest_vertex));
+    return inside;
+  };
+
   // --- attempts: schedule -> foot -> region -> self-check, for each h and W_int tried
   const std::vector<double> w_steps =
       options.w_int > 0 ? std::vector<double>{options.w_int} : std::vector<double>{0.25, 0.5, 1.0};
-  double preprocess_seconds = 0, background_seconds = 0;
   bool cancelled = false;
   std::string collapse_phase;
   auto attempt_at = [&](double h_try) {
@@ -326,6 +341,14 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     const std::vector<char> coarse_region = relief_region(mesh, coarse.contour, options.closed, inside_left);
     const StepEvidence coarse_step = measure_step(mesh, coarse.contour, coarse_region, h_try, evidence_options);
     const double coarse_step_share = coarse_step.step_share;
+    // The coarse region's relief, under the background filled in from around it: measured (one sparse
+    // solve per h) only for a refined region that strays from the coarse one (coarse_relief_kept).
+    std::unique_ptr<BackgroundResult> coarse_fill;
+    auto kept_of_coarse_relief = [&](const std::vector<char>& region) {
+      if (!coarse_fill) coarse_fill = std::make_unique<BackgroundResult>(fill_background(mesh, coarse_region, h_try));
+      const double step = coarse_step.step_height > 0 ? std::min(h_try, coarse_step.step_height) : h_try;
+      return kept_relief_share(mesh, *coarse_fill, region, 0.5 * step);
+    };
     // The foot stage and the self-check of one refined run (a.run).
     auto settle_and_judge = [&](Attempt& a, BackgroundInside* inside_out) {
       // gated (foot_snap_blended): left alone unless most snaxels have a clean background outside.
@@ -373,6 +396,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       a.evidence.abandoned_area_share = a.run.abandoned && a.run.abandoned_for_area ? a.run.abandoned_area_share : -1.0;
       a.evidence.abandoned_left_share = a.run.abandoned && !a.run.abandoned_for_area ? a.run.abandoned_left_share : -1.0;
       a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
+      if (options.coarse_relief_kept && a.evidence.coarse_iou < self_check.min_coarse_iou &&
+          coarse_step_share >= self_check.min_step_share)
+        a.evidence.coarse_relief_kept = kept_of_coarse_relief(a.region);
       if (options.closed) {
         std::vector<Vec3> polyline;
         for (const SurfacePoint& p : a.run.contour) polyline.push_back(position(mesh, p));
@@ -396,16 +422,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       // The region-wide check only where the contour-wise one holds (a failing attempt is doubtful
       // already), and for the repair of a region that took in background.
       if (judge(a.evidence, h_try, contour_wise).holds) {
-        if (!cache_->background_inside) cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh);
-        a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / h_try;
-        BackgroundInside inside = cache_->background_inside->measure(
-            a.region, h_try, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * h_try);
-        background_seconds += inside.seconds;
-        a.evidence.region_checked = inside.checked;
-        a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;
-        a.evidence.background_depth = inside.depth / h_try;
-        a.evidence.background_area = inside.area / (h_try * h_try);
-        if (inside.deepest_vertex >= 0) a.evidence.background_where = mesh.to_file(mesh.position(inside.deepest_vertex));
+        BackgroundInside inside = measure_region_wide(a);
         if (inside_out) *inside_out = std::move(inside);
       }
       a.check = judge(a.evidence, h_try, self_check, far_index >= 0 ? &far_position : nullptr);
@@ -657,6 +674,8 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                    {"foot_gap_q75", step.foot_gap_q75 / best.h},
                    {"background_depth", best.evidence.background_depth},
                    {"background_area", best.evidence.background_area}});
+  if (best.evidence.coarse_relief_kept >= 0)
+    result.checks.push_back({"coarse_relief_kept", best.evidence.coarse_relief_kept});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
   result.reasons = best.check.reasons;
   if (!second_guess_reason.empty() && result.reasons.empty()) result.reasons.push_back(second_guess_reason);

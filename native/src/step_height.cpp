@@ -140,16 +140,10 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
   std::vector<StepHeightGuess> out;
   if (path.size() < 2) return out;
   if (closed) {
-    // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot; cotangent
-    // weights can be singular over a sharp wall's projection, uniform ones are not.
+    // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot.
     const std::vector<char> region = relief_region(mesh, path, true, relief_left);
     const double scale = options.fill_scale_edges * mesh.average_edge_length();
-    BackgroundResult fill = BackgroundSolver(mesh).solve(region, scale);
-    if (!fill.ok()) {
-      BackgroundOptions uniform;
-      uniform.laplacian = BackgroundLaplacian::Uniform;
-      fill = BackgroundSolver(mesh, uniform).solve(region, scale);
-    }
+    const BackgroundResult fill = fill_background(mesh, region, scale);
     if (!fill.ok()) return out;
     std::vector<WeightedHeight> heights;
     heights.reserve(fill.region_vertices.size());

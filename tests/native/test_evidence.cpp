@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "relief_snake/background.hpp"
 #include "relief_snake/evidence.hpp"
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/region.hpp"
@@ -143,6 +144,14 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   c = judge(e, 1.0);
   ASSERT_EQ(c.reasons.size(), 1u);
   EXPECT_NE(c.reasons.front().find("coarse"), std::string::npos);
+  // What refinement let go of was background (a bridged concavity): the region kept the coarse
+  // region's relief. Measured and under the share, it still fails.
+  e.coarse_relief_kept = 0.95;
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.coarse_relief_kept = 0.5;
+  EXPECT_FALSE(judge(e, 1.0).holds);
+  e.coarse_relief_kept = -1;  // not measured: the overlap alone decides
+  EXPECT_FALSE(judge(e, 1.0).holds);
   e.coarse_step_share = 0.2;  // the coarse contour never reached the step: leaving it behind is fine
   EXPECT_TRUE(judge(e, 1.0).holds);
   e.area_ratio = 2.0;
@@ -187,6 +196,37 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   EXPECT_TRUE(judge(e, 1.0).holds);
   e.covered_share = -1;
   EXPECT_TRUE(judge(e, 1.0).holds);
+}
+
+// The relief a coarse region encloses (background.hpp's fill from around it): a region that
+// keeps the disk keeps all of it, whatever background it leaves; one that lost half the disk
+// keeps about half; a region of background keeps none.
+TEST(Evidence, KeptReliefShareCountsReliefNotBackground) {
+  const syn::Scan scan = disk_scan(syn::Background::Plane, syn::Step::Sharp);
+  const Mesh mesh = syn::to_mesh(scan);
+  const auto region_where = [&](auto inside) {
+    std::vector<char> region(mesh.n_vertices(), 0);
+    for (std::size_t i = 0; i < scan.n_vertices(); ++i) {
+      const int v = mesh.input_to_mesh(i);
+      if (v >= 0) region[v] = inside(scan.UV[2 * i], scan.UV[2 * i + 1]) ? 1 : 0;
+    }
+    return region;
+  };
+  // The coarse region: the disk (radius 12) and a lobe of background beside it out to 20.
+  const std::vector<char> coarse =
+      region_where([](double u, double w) { return std::hypot(u, w) < 12.5 || (u > 0 && u < 20 && std::fabs(w) < 4); });
+  const BackgroundResult fill = fill_background(mesh, coarse, scan.h);
+  ASSERT_TRUE(fill.ok()) << fill.message;
+  const double rise = 0.5 * scan.h;
+  const std::vector<char> disk = region_where([](double u, double w) { return std::hypot(u, w) < 12.5; });
+  EXPECT_GT(kept_relief_share(mesh, fill, disk, rise), 0.98);
+  EXPECT_LT(region_iou(mesh, coarse, disk), 0.95);  // it left the lobe behind
+  const double half = kept_relief_share(mesh, fill, region_where([](double u, double) { return u < 0; }), rise);
+  EXPECT_GT(half, 0.4);
+  EXPECT_LT(half, 0.6);
+  EXPECT_LT(kept_relief_share(mesh, fill, region_where([](double u, double w) { return u > 14 && std::fabs(w) < 4; }), rise), 0.01);
+  // Nothing in the fill's region stands that high: not measured.
+  EXPECT_EQ(kept_relief_share(mesh, fill, disk, 100 * scan.h), -1.0);
 }
 
 // A blended step beside a flat band running off the mesh (an open contour's scan).

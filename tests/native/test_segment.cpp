@@ -411,3 +411,53 @@ TEST(SegmentEstimate, AGuessKeptAfterAFailedFirstEstimateStaysDoubtful) {
   const syn::Score s = syn::score(contour, trusted.relief_vertices, random.scan);
   EXPECT_GE(s.iou, 0.95);
 }
+
+namespace {
+// Runs one random scan with the h a user would type (the truth's typed_step_height).
+struct RandomRun {
+  syn::RandomScan random;
+  Mesh mesh;
+  Options options;
+  explicit RandomRun(std::uint64_t seed) : random(syn::generate_random(seed)), mesh(syn::to_mesh(random.scan)) {
+    options.closed = random.picks.closed;
+    options.step_height = random.scan.h * random.draw.typed_factor;
+  }
+  Result run(const Options& o) const { return segment(mesh, random.picks.vertices, o); }
+  syn::Score score(const Result& r) const {
+    syn::Polyline contour;
+    contour.points = r.polyline;
+    contour.closed = r.closed;
+    return syn::score(contour, r.relief_vertices, random.scan);
+  }
+};
+
+bool has_reason(const Result& r, const std::string& part) {
+  for (const std::string& reason : r.reasons)
+    if (reason.find(part) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+// Random scan 1051: a C on a sphere, one edge per h. The coarse contour bridges the C's gap and
+// refinement rightly leaves the gap's background behind: the final region overlaps the coarse one
+// by under 60%. It kept the coarse region's relief, so it did not cross the relief: converged
+// (on the overlap alone, coarse_relief_kept=0, it was reported doubtful).
+TEST(SegmentCheck, LettingGoOfABridgedConcavityIsNoCrossing) {
+  const RandomRun scan(1051);
+  ASSERT_EQ(scan.random.draw.axes["shape"], "c");
+  EXPECT_TRUE(Options().coarse_relief_kept);
+  const Result result = scan.run(scan.options);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  EXPECT_LT(check_value(result, "coarse_iou"), 0.6);
+  EXPECT_GE(check_value(result, "coarse_relief_kept"), 0.8);
+  const syn::Score s = scan.score(result);  // accurate as the random suite counts it
+  EXPECT_GE(s.iou, syn::one_edge_floor(scan.random.scan).vertices);
+  EXPECT_LE(s.mean_to_truth, 1.0);
+  EXPECT_LE(s.mean_from_truth, 1.0);
+
+  Options overlap_only = scan.options;
+  overlap_only.coarse_relief_kept = false;
+  const Result old = scan.run(overlap_only);
+  EXPECT_EQ(old.status, Status::Doubtful);
+  EXPECT_TRUE(has_reason(old, "overlaps the coarse contour's")) << old.message;
+}

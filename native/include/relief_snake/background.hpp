@@ -114,6 +114,12 @@ class BackgroundSolver {
   std::vector<std::size_t> ring_offset_;
 };
 
+/// One fill with `options` and, where that fails, with uniform weights instead (cotangent weights
+/// over a sharp wall's projection can be singular; uniform ones are not). A new solver each call:
+/// for one-off fills (BackgroundSolver keeps its precomputation for several).
+BackgroundResult fill_background(const Mesh& mesh, const std::vector<char>& region, double h,
+                                 const BackgroundOptions& options = {});
+
 /// Heights above the base at surface points: (position(p) - base(p)) . n_base(p) with the base
 /// position and normal interpolated linearly in p's face. 0 for points on faces the fit left
 /// untouched (far from the region). result must be an ok() result for this mesh.

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "relief_snake/background.hpp"
 #include "relief_snake/mesh.hpp"
 #include "relief_snake/surface_point.hpp"
 
@@ -99,7 +100,11 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
 struct SelfCheckOptions {
   double min_step_share = 0.9;    ///< share of the measured contour that must sit on a step
   double min_measured_share = 0.3;  ///< below this the step could not be checked at all
-  double min_coarse_iou = 0.6;    ///< overlap of the final region with the coarse phase's
+  double min_coarse_iou = 0.6;    ///< overlap of the final region with the coarse phase's ...
+  /// ... unless the final region keeps at least this share of the coarse region's relief
+  /// (ContourEvidence::coarse_relief_kept): what refinement let go of was background, a concavity
+  /// the coarse contour bridged (a C's gap, a gear's slots), not relief it crossed.
+  double min_coarse_relief_kept = 0.8;
   double max_step_ratio = 2.0;    ///< the step found and h may differ by at most this factor
   double min_foot_share = 0.8;    ///< share of the on-step contour that must sit at the step's foot
   /// Closed contours: the region's vector area along the contour's, against the contour's own
@@ -134,6 +139,9 @@ struct ContourEvidence {
   StepEvidence step;            ///< along the final contour
   double coarse_step_share = 0; ///< the coarse contour's share on a step
   double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
+  /// Where coarse_iou fails: the share of the coarse region's relief (its vertices standing half a step
+  /// above the background filled in from around it) the final region keeps; -1: not measured.
+  double coarse_relief_kept = -1;
   double area_ratio = 1;        ///< closed contours: the region's vector area against the contour's (1: they agree)
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
   /// The refinement was abandoned with the contour enclosing this share of the coarse contour's
@@ -184,6 +192,12 @@ struct FlagRun {
   int length = 0, middle = -1;
 };
 FlagRun longest_run(const std::vector<char>& flags, bool closed);
+
+/// The share (by area) of the relief in `fill`'s region, the vertices standing at least `rise` above
+/// the filled-in background (background.hpp), that `region` (#V flags) keeps; -1 when the fill failed
+/// or nothing stands that high.
+double kept_relief_share(const Mesh& mesh, const BackgroundResult& fill, const std::vector<char>& region,
+                         double rise);
 
 /// Area (sum of vertex areas) of the flagged vertices.
 double region_area(const Mesh& mesh, const std::vector<char>& region);

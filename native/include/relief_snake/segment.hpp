@@ -96,6 +96,10 @@ struct Options {
   bool foot_snap_blended = true;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
+  /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
+  /// doubtful only if it also lost the coarse region's relief (not background it bridged, as a C's
+  /// gap); off: on the overlap alone (not in the paper).
+  bool coarse_relief_kept = true;
   /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
