@@ -286,6 +286,11 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   // The contour-wise verdict without the far run, which the region-wide check replaces where it runs.
   SelfCheckOptions contour_wise = self_check;
   contour_wise.max_far_run = std::numeric_limits<double>::infinity();
+  // The verdicts with the refit-free step ratio, for a step the refit confirmed (judge_with_confirmed_step).
+  SelfCheckOptions step_confirmed = self_check;
+  step_confirmed.max_step_ratio = std::max(self_check.max_step_ratio, SelfCheckOptions().max_step_ratio);
+  SelfCheckOptions step_confirmed_contour_wise = contour_wise;
+  step_confirmed_contour_wise.max_step_ratio = step_confirmed.max_step_ratio;
   EvidenceOptions evidence_options;
   evidence_options.closed = options.closed;
 
@@ -528,6 +533,19 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     return best;
   };
 
+  // A kept contour whose step the refit measured again at that step's height, where the refit's
+  // contour had weaker evidence: the step is the scan's and h was off, so the contour is judged
+  // with the refit-free step ratio (its region-wide check run first, which that ratio had held back).
+  auto judge_with_confirmed_step = [&](Attempt& kept, double found, const Attempt& refit) {
+    const double again = refit.usable() ? refit.evidence.step.step_height : 0.0;
+    if (!(again > 0) || std::fabs(std::log(again / found)) >= std::log(1.15)) return false;
+    if (!judge(kept.evidence, kept.h, step_confirmed_contour_wise).holds) return false;
+    if (!judge(kept.evidence, kept.h, contour_wise).holds) measure_region_wide(kept);
+    SelfCheck loose = judge(kept.evidence, kept.h, step_confirmed);
+    if (!loose.holds) return false;
+    kept.check = std::move(loose);
+    return true;
+  };
   // One h, then the refit along the contour; the notes go to the result if it is kept.
   std::vector<double> tried;
   auto attempt_with_refits = [&](double h_first, std::vector<std::string>* notes) {
@@ -539,7 +557,14 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       tried.push_back(found);
       Attempt next = attempt_at(found);
       if (cancelled) break;
-      if (!better(next, kept)) break;
+      if (!better(next, kept)) {
+        if (options.confirmed_step && !kept.check.holds && judge_with_confirmed_step(kept, found, next))
+          notes->push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(kept.h) +
+                           "; segmented again with h = " + fmt(found) + ", the step measured " +
+                           fmt(next.evidence.step.step_height) + " again but that contour's evidence was weaker: "
+                           "this one is kept");
+        break;
+      }
       notes->push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(kept.h) +
                        "; segmented again with h = " + fmt(found));
       kept = std::move(next);

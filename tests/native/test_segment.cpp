@@ -461,3 +461,31 @@ TEST(SegmentCheck, LettingGoOfABridgedConcavityIsNoCrossing) {
   EXPECT_EQ(old.status, Status::Doubtful);
   EXPECT_TRUE(has_reason(old, "overlaps the coarse contour's")) << old.message;
 }
+
+// Random scan 2028: a blended rounded box, h typed x1.76. The step found (about x0.57 of h) is
+// refitted; at that h the contour's evidence is weaker, but the refit measures the same step
+// again: the step is the scan's and h was off, so the first contour is kept and converged (with
+// confirmed_step=0 it is doubtful: its step is over x1.5 from h).
+TEST(SegmentRefit, AStepMeasuredAgainAtItsOwnHeightKeepsTheContour) {
+  const RandomRun scan(2028);
+  EXPECT_TRUE(Options().confirmed_step);
+  const Result result = scan.run(scan.options);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  EXPECT_EQ(result.parameters.step_height, scan.options.step_height);
+  const double found = check_value(result, "step_height");
+  EXPECT_GT(scan.options.step_height / found, 1.5);
+  EXPECT_LT(scan.options.step_height / found, 2.0);
+  bool noted = false;
+  for (const std::string& n : result.notes) noted = noted || n.find("again but that contour's evidence was weaker") != std::string::npos;
+  EXPECT_TRUE(noted);
+  const syn::Score s = scan.score(result);  // accurate as the random suite counts it
+  EXPECT_GE(s.iou, syn::one_edge_floor(scan.random.scan).vertices);
+  EXPECT_LE(s.mean_to_truth, 1.0);
+  EXPECT_LE(s.mean_from_truth, 1.0);
+
+  Options tight = scan.options;
+  tight.confirmed_step = false;
+  const Result old = scan.run(tight);
+  EXPECT_EQ(old.status, Status::Doubtful);
+  EXPECT_TRUE(has_reason(old, "far from the step height used")) << old.message;
+}

@@ -100,6 +100,10 @@ struct Options {
   /// doubtful only if it also lost the coarse region's relief (not background it bridged, as a C's
   /// gap); off: on the overlap alone (not in the paper).
   bool coarse_relief_kept = true;
+  /// With the refit: a contour whose step disagrees with h (by x1.5 to x2) but was measured again
+  /// at that step's height, where the contour's evidence was weaker, is kept as it is and judged
+  /// without the refit's tighter step ratio (not in the paper).
+  bool confirmed_step = true;
   /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
