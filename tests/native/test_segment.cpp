@@ -247,15 +247,16 @@ TEST(SegmentRefit, AStepFoundAboveHCanBeRefittedSoonerThanOneBelow) {
   EXPECT_FALSE(refit_wanted(std::nan(""), 1.0, {1.0}, o));
   o.refit_ratio_up = 1.5;  // refit_ratio caps the upward threshold
   EXPECT_TRUE(refit_wanted(1.4, 1.0, {1.0}, o));
-  o.refit_ratio_up = 1.3;  // symmetric: the default
+  o.refit_ratio_up = 1.3;  // symmetric
   EXPECT_FALSE(refit_wanted(1.2, 1.0, {1.0}, o));
-  EXPECT_EQ(Options().refit_ratio_up, Options().refit_ratio);
+  EXPECT_EQ(Options().refit_ratio_up, 1.15);  // the default: sooner above h
+  EXPECT_LT(Options().refit_ratio_up, Options().refit_ratio);
 }
 
 // A disk blended over 1 h (seven edges per h), h typed x0.75: the small h holds the snake up the slope,
-// where the step found (x1.28 h) is within x1.3 of h and, by default, nothing is refitted. With a step
-// found above h refitted from x1.15 on (refit_ratio_up), the contour comes down towards the foot. The
-// foot stage is off so that only the refit moves it.
+// where the step found (x1.28 h) is within x1.3 of h and, with a symmetric refit, nothing is refitted.
+// With a step found above h refitted from x1.15 on (refit_ratio_up, the default), the contour comes
+// down towards the foot. The foot stage is off so that only the refit moves it.
 TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwardsFromRefitRatioUp) {
   const syn::ScanSpec spec = wide_blended_disk();
   const syn::Scan scan = syn::generate(spec);
@@ -264,7 +265,7 @@ TEST(SegmentRefit, ASmallTypedHOnABlendedStepIsRefittedUpwardsFromRefitRatioUp) 
   Options options;
   options.step_height = 0.75 * scan.h;
   options.foot_snap_blended = false;
-  options.refit_ratio_up = 1.15;
+  EXPECT_EQ(options.refit_ratio_up, 1.15);
   Options symmetric = options;
   symmetric.refit_ratio_up = symmetric.refit_ratio;
   const Result refitted = segment(mesh, picks.vertices, options), before = segment(mesh, picks.vertices, symmetric);
