@@ -424,19 +424,30 @@ struct RandomRun {
     options.step_height = random.scan.h * random.draw.typed_factor;
   }
   Result run(const Options& o) const { return segment(mesh, random.picks.vertices, o); }
-  syn::Score score(const Result& r) const {
+  /// Accurate as the random suite counts it: mean distances both ways within one average edge, IoU at
+  /// least the one-edge floor.
+  void expect_accurate(const Result& r) const {
     syn::Polyline contour;
     contour.points = r.polyline;
     contour.closed = r.closed;
-    return syn::score(contour, r.relief_vertices, random.scan);
+    const syn::Score s = syn::score(contour, r.relief_vertices, random.scan);
+    EXPECT_GE(s.iou, syn::one_edge_floor(random.scan).vertices);
+    EXPECT_LE(s.mean_to_truth, 1.0);
+    EXPECT_LE(s.mean_from_truth, 1.0);
+  }
+  /// With `change` applied to the options, the result is doubtful with a reason containing `reason`.
+  template <typename Change>
+  void expect_doubtful_with(Change change, const std::string& reason) const {
+    Options o = options;
+    change(o);
+    const Result r = run(o);
+    EXPECT_EQ(r.status, Status::Doubtful);
+    bool found = false;
+    for (const std::string& text : r.reasons) found = found || text.find(reason) != std::string::npos;
+    EXPECT_TRUE(found) << r.message;
   }
 };
 
-bool has_reason(const Result& r, const std::string& part) {
-  for (const std::string& reason : r.reasons)
-    if (reason.find(part) != std::string::npos) return true;
-  return false;
-}
 }  // namespace
 
 // Random scan 1051: a C on a sphere, one edge per h. The coarse contour bridges the C's gap and
@@ -451,16 +462,8 @@ TEST(SegmentCheck, LettingGoOfABridgedConcavityIsNoCrossing) {
   ASSERT_EQ(result.status, Status::Converged) << result.message;
   EXPECT_LT(check_value(result, "coarse_iou"), 0.6);
   EXPECT_GE(check_value(result, "coarse_relief_kept"), 0.8);
-  const syn::Score s = scan.score(result);  // accurate as the random suite counts it
-  EXPECT_GE(s.iou, syn::one_edge_floor(scan.random.scan).vertices);
-  EXPECT_LE(s.mean_to_truth, 1.0);
-  EXPECT_LE(s.mean_from_truth, 1.0);
-
-  Options overlap_only = scan.options;
-  overlap_only.coarse_relief_kept = false;
-  const Result old = scan.run(overlap_only);
-  EXPECT_EQ(old.status, Status::Doubtful);
-  EXPECT_TRUE(has_reason(old, "overlaps the coarse contour's")) << old.message;
+  scan.expect_accurate(result);
+  scan.expect_doubtful_with([](Options& o) { o.coarse_relief_kept = false; }, "overlaps the coarse contour's");
 }
 
 // Random scan 2028: a blended rounded box, h typed x1.76. The step found (about x0.57 of h) is
@@ -479,14 +482,6 @@ TEST(SegmentRefit, AStepMeasuredAgainAtItsOwnHeightKeepsTheContour) {
   bool noted = false;
   for (const std::string& n : result.notes) noted = noted || n.find("again but that contour's evidence was weaker") != std::string::npos;
   EXPECT_TRUE(noted);
-  const syn::Score s = scan.score(result);  // accurate as the random suite counts it
-  EXPECT_GE(s.iou, syn::one_edge_floor(scan.random.scan).vertices);
-  EXPECT_LE(s.mean_to_truth, 1.0);
-  EXPECT_LE(s.mean_from_truth, 1.0);
-
-  Options tight = scan.options;
-  tight.confirmed_step = false;
-  const Result old = scan.run(tight);
-  EXPECT_EQ(old.status, Status::Doubtful);
-  EXPECT_TRUE(has_reason(old, "far from the step height used")) << old.message;
+  scan.expect_accurate(result);
+  scan.expect_doubtful_with([](Options& o) { o.confirmed_step = false; }, "far from the step height used");
 }
