@@ -95,6 +95,28 @@ TEST(Background, FixedRingAndUniformLaplacianAlsoWork) {
     }
 }
 
+// fill_background() is one solve with the options given where that solve works (the uniform-weights
+// retry is for a singular cotangent system only), and passes a failure through.
+TEST(Background, FillBackgroundIsOneSolveWithItsOptions) {
+  const synthetic::Scan scan = sharp_duck(Background::Cylinder, 20000);
+  const Mesh mesh = synthetic::to_mesh(scan);
+  const std::vector<char> region = truth_region(scan);
+  for (const BackgroundLaplacian laplacian : {BackgroundLaplacian::Cotangent, BackgroundLaplacian::Uniform}) {
+    BackgroundOptions options;
+    options.laplacian = laplacian;
+    const BackgroundResult direct = BackgroundSolver(mesh, options).solve(region, scan.h);
+    const BackgroundResult helper = fill_background(mesh, region, scan.h, options);
+    ASSERT_TRUE(direct.ok() && helper.ok()) << direct.message << helper.message;
+    EXPECT_EQ(helper.height, direct.height);
+  }
+  BackgroundOptions cotangent, uniform;
+  uniform.laplacian = BackgroundLaplacian::Uniform;
+  EXPECT_NE(fill_background(mesh, region, scan.h, cotangent).height,
+            fill_background(mesh, region, scan.h, uniform).height);  // the options are used
+  const BackgroundResult empty = fill_background(mesh, std::vector<char>(mesh.n_vertices(), 0), scan.h);
+  EXPECT_EQ(empty.status, BackgroundStatus::EmptyRegion);
+}
+
 TEST(Background, NoiseOnTheRingShowsInTheResidual) {
   const synthetic::Scan clean = sharp_duck(Background::Plane, 20000, 0.0);
   const synthetic::Scan noisy = sharp_duck(Background::Plane, 20000, 0.05);
