@@ -354,6 +354,9 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
       !(all.coarse_relief_kept >= options.min_coarse_relief_kept);
   if (coarse_left)
     check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(all.coarse_iou) +
+                            (all.coarse_relief_kept >= 0
+                                 ? " and keeps " + percent(all.coarse_relief_kept) + " of the relief it enclosed"
+                                 : std::string()) +
                             ": refinement moved far from where the step was first found");
   if (all.abandoned_area_share >= 0)
     check.reasons.push_back("the refinement was stopped when the contour enclosed only " +
