@@ -40,7 +40,7 @@ double risen_area(const Enclosure& enclosure, double rise) {
 
 double covered_share(const Mesh& mesh, const Enclosure& enclosure, const std::vector<char>& region, double h,
                      double step_found, const EnclosureOptions& options) {
-  const double judged = step_found > 0 ? std::min(h, step_found) : h;
+  const double judged = judged_step(h, step_found);
   if (!(judged > 0) || enclosure.heights.empty()) return -1;
   const double risen = risen_area(enclosure, options.rise * judged);
   if (risen < options.min_area * judged * judged && risen < options.min_share * enclosure.enclosed_area) return -1;

@@ -351,8 +351,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     std::unique_ptr<BackgroundResult> coarse_fill;
     auto kept_of_coarse_relief = [&](const std::vector<char>& region) {
       if (!coarse_fill) coarse_fill = std::make_unique<BackgroundResult>(fill_background(mesh, coarse_region, h_try));
-      const double step = coarse_step.step_height > 0 ? std::min(h_try, coarse_step.step_height) : h_try;
-      return kept_relief_share(mesh, *coarse_fill, region, 0.5 * step);
+      return kept_relief_share(mesh, *coarse_fill, region, 0.5 * judged_step(h_try, coarse_step.step_height));
     };
     // The foot stage and the self-check of one refined run (a.run).
     auto settle_and_judge = [&](Attempt& a, BackgroundInside* inside_out) {
@@ -557,16 +556,15 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
       tried.push_back(found);
       Attempt next = attempt_at(found);
       if (cancelled) break;
+      const std::string refitted = "the step along the contour measured " + fmt(found) + " against h = " +
+                                   fmt(kept.h) + "; segmented again with h = " + fmt(found);
       if (!better(next, kept)) {
         if (options.confirmed_step && !kept.check.holds && judge_with_confirmed_step(kept, found, next))
-          notes->push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(kept.h) +
-                           "; segmented again with h = " + fmt(found) + ", the step measured " +
-                           fmt(next.evidence.step.step_height) + " again but that contour's evidence was weaker: "
-                           "this one is kept");
+          notes->push_back(refitted + ", the step measured " + fmt(next.evidence.step.step_height) +
+                           " again but that contour's evidence was weaker: this one is kept");
         break;
       }
-      notes->push_back("the step along the contour measured " + fmt(found) + " against h = " + fmt(kept.h) +
-                       "; segmented again with h = " + fmt(found));
+      notes->push_back(refitted);
       kept = std::move(next);
     }
     return kept;
@@ -708,8 +706,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     // Picks on one side of the relief can still leave a snake that settles on something. Judged
     // with the step found along the contour where it is lower than h (a rough h given too large,
     // or a background the quadric follows only roughly: the step is there, the snake measured it).
-    const double found = best.evidence.step.step_height;
-    const double judged = found > 0 ? std::min(best.h, found) : best.h;
+    const double judged = judged_step(best.h, best.evidence.step.step_height);
     const double risen = risen_area(enclosure, EnclosureOptions().rise * judged);
     result.checks.push_back({"enclosed_risen_area", risen / (judged * judged)});
     result.checks.push_back({"enclosed_risen_share", enclosure.enclosed_area > 0 ? risen / enclosure.enclosed_area : 0.0});

@@ -11,6 +11,7 @@
 // under the contour, and the heights above it of the vertices the contour encloses. A relief of step h inside shows as
 // area standing at least half an h above that background; picks on one side show none (or
 // only a sliver at the contour, where it runs onto the relief).
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct Enclosure {
 
 /// path: the closed initial contour; inside_left: its enclosed side (contour_orientation_left()).
 Enclosure measure_enclosure(const Mesh& mesh, const SurfacePath& path, bool inside_left);
+
+/// The step a rise is judged against: the lower of h and the step found along a contour, when one
+/// was found (> 0), else h (a rough h given too large, or a background the quadric follows roughly).
+inline double judged_step(double h, double step_found) { return step_found > 0 ? std::min(h, step_found) : h; }
 
 /// Area of the enclosed vertices standing at least `rise` above the background.
 double risen_area(const Enclosure& enclosure, double rise);
