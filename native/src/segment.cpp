@@ -198,7 +198,6 @@ static PlanarityField& planarity_for(const Mesh& mesh, std::unique_ptr<Planarity
 
 Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options& options,
                           const ProgressCallback& progress) {
-  const auto t_start = Clock::now();
   const Mesh& mesh = mesh_;
   validate_options(mesh, options);
   const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
@@ -214,6 +213,85 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
                         progress);
   }
 
+  if (!options.closed && options.relief_side == ReliefSide::Auto) return segment_deciding_side(picks, options, progress);
+  return segment_one_side(picks, options, progress);
+}
+
+namespace {
+
+double check_named(const Result& result, const std::string& name, double none) {
+  for (const auto& [key, value] : result.checks)
+    if (key == name) return value;
+  return none;
+}
+
+}  // namespace
+
+// A contour mostly on a step that fails for another reason (a near miss, a bridged concavity) is on
+// the right side, and the other side's background could only give a wrong region (one that, on
+// striations, can even pass the self-check: random scan 1014 did with every failed side swapped).
+bool looks_like_the_wrong_side(const Result& result) {
+  const double step_share = check_named(result, "step_share", 0.0);
+  return step_share < 0.5 || check_named(result, "measured_share", 0.0) < SelfCheckOptions().min_measured_share ||
+         check_named(result, "other_side_share", 0.0) > step_share;
+}
+
+// An open contour's relief side decided from the surface (step_height.hpp: the side that rises
+// along the picks) can be wrong: the strip compared may not reach a relief picked far from it, or
+// the background may curve away from the fit on the other side. A wrong side gives a region on the
+// background, which the self-check flags (a contour off any step, a clearer step from the other
+// side). So when the decided side's result fails its self-check that way, or the snake collapses on
+// it, the other side is segmented too, and kept if its result passes the self-check.
+Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, const Options& options,
+                                        const ProgressCallback& progress) {
+  Result first;
+  std::string first_error;
+  ReliefSide decided = ReliefSide::Auto;
+  try {
+    first = segment_one_side(picks, options, progress, &decided);
+    if (first.status == Status::Converged || first.status == Status::Cancelled || !looks_like_the_wrong_side(first))
+      return first;
+  } catch (const Error& e) {
+    first_error = e.what();
+  }
+  // An error before the side was decided (bad picks, a mesh without boundary) is the other side's too.
+  if (decided == ReliefSide::Auto) throw Error(first_error);
+  Options other = options;
+  const bool first_left = decided == ReliefSide::Left;
+  other.relief_side = first_left ? ReliefSide::Right : ReliefSide::Left;
+  const char* first_name = first_left ? "left" : "right";
+  const char* other_name = first_left ? "right" : "left";
+  Result second;
+  try {
+    second = segment_one_side(picks, other, progress);
+  } catch (const Error&) {
+    if (!first_error.empty()) throw Error(first_error);
+    first.notes.push_back(std::string("the other side (") + other_name + ") was tried too: it gave no result");
+    return first;
+  }
+  if (second.status == Status::Cancelled) return second;
+  const std::string why = first_error.empty() ? "its result failed the self-check (" +
+                                                    (first.reasons.empty() ? first.message : first.reasons.front()) + ")"
+                                              : "it gave no result (" + first_error + ")";
+  if (second.status == Status::Converged || !first_error.empty()) {
+    second.notes.insert(second.notes.begin(), std::string("the relief side was decided from the surface as ") +
+                                                  first_name + " of the picks, but " + why + "; the " + other_name +
+                                                  " side was segmented instead");
+    second.attempts += first.attempts;
+    return second;
+  }
+  first.notes.push_back(std::string("the other side (") + other_name +
+                        ") was tried too and its result failed the self-check as well");
+  first.attempts += second.attempts;
+  return first;
+}
+
+Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const Options& options,
+                                   const ProgressCallback& progress, ReliefSide* side_decided) {
+  const auto t_start = Clock::now();
+  const Mesh& mesh = mesh_;
+  const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
+  const int component = mesh.component(pick_vertices.front());
   Result result;
   result.closed = options.closed;
 
@@ -261,7 +339,9 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
   };
   StepHeightEstimate estimate;
   if (!h_given || !side_given) {
-    estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left);
+    StepHeightOptions estimate_options;
+    estimate_options.decide_side = !side_given;
+    estimate = estimate_step_height(mesh, initial.path, options.closed, inside_left, estimate_options);
     if (!side_given) {
       inside_left = estimate.relief_left;
       result.notes.push_back(std::string("the relief side was decided from the surface: ") +
@@ -275,6 +355,7 @@ Result Segmenter::segment(const std::vector<std::int64_t>& picks, const Options&
     }
   }
   result.relief_side = inside_left ? ReliefSide::Left : ReliefSide::Right;
+  if (side_decided) *side_decided = result.relief_side;
   // What the picks enclose, for the check that they go round a relief at all (enclosure.hpp).
   const Enclosure enclosure = options.closed ? measure_enclosure(mesh, initial.path, inside_left) : Enclosure{};
 

@@ -116,7 +116,9 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
     const auto right = heights_of(mesh, relief_region(mesh, path, false, false), background, &near);
     estimate.left_rise = weighted_quantile(left, 0.9);
     estimate.right_rise = weighted_quantile(right, 0.9);
-    estimate.relief_left = estimate.left_rise >= estimate.right_rise;
+    // A side the user named is measured as named: the other side's rise (a background that curves
+    // away from the fit, the far side's own relief) says nothing about this relief's step.
+    estimate.relief_left = options.decide_side ? estimate.left_rise >= estimate.right_rise : inside_left;
     heights = estimate.relief_left ? left : right;
   }
   if (heights.empty()) return estimate;
@@ -139,23 +141,29 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
                                                       const StepHeightOptions& options) {
   std::vector<StepHeightGuess> out;
   if (path.size() < 2) return out;
-  if (closed) {
-    // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot.
-    const std::vector<char> region = relief_region(mesh, path, true, relief_left);
-    const double scale = options.fill_scale_edges * mesh.average_edge_length();
-    const BackgroundResult fill = fill_background(mesh, region, scale);
-    if (!fill.ok()) return out;
+  // The thin-plate fill follows a vase or a wave that a quadric over one plane cannot. Closed: the
+  // fill of the region the picks enclose from a ring around it. Open: the fill of the whole relief
+  // side from a ring on the picks' side, its heights taken over the wide strip along the picks (where
+  // the fill is held by its ring; it also reaches a relief picked farther away than the first
+  // estimate's narrow strip does).
+  const std::vector<char> region = relief_region(mesh, path, closed, relief_left);
+  const double scale = options.fill_scale_edges * mesh.average_edge_length();
+  const BackgroundResult fill = fill_background(mesh, region, scale);
+  const std::vector<int> samples = closed ? std::vector<int>() : contour_band_vertices(mesh, path, options.band_rings);
+  const std::vector<char> near =
+      closed ? std::vector<char>() : near_samples(mesh, samples, options.wide_strip_share * path_length(mesh, path, false));
+  if (fill.ok()) {
     std::vector<WeightedHeight> heights;
     heights.reserve(fill.region_vertices.size());
-    for (const int v : fill.region_vertices) heights.push_back({fill.height[v], mesh.vertex_area(v)});
+    for (const int v : fill.region_vertices)
+      if (closed || near[v]) heights.push_back({fill.height[v], mesh.vertex_area(v)});
     relief_group_guesses(heights, options, "the background filled in from around the picks", &out);
-  } else {
-    const std::vector<int> samples = contour_band_vertices(mesh, path, options.band_rings);
+  } else if (closed) {
+    return out;
+  }
+  if (!closed) {
     const QuadraticBackground background = fit_background(mesh, samples);
-    const std::vector<char> near =
-        near_samples(mesh, samples, options.wide_strip_share * path_length(mesh, path, false));
-    relief_group_guesses(heights_of(mesh, relief_region(mesh, path, false, relief_left), background, &near), options,
-                         "a wider strip along the picks", &out);
+    relief_group_guesses(heights_of(mesh, region, background, &near), options, "a wider strip along the picks", &out);
     const double side_rise = relief_left ? first.left_rise : first.right_rise;
     if (side_rise > 0) out.push_back({side_rise, "the 90% height of the relief side along the picks"});
   }

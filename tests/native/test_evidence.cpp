@@ -273,6 +273,57 @@ TEST(StepHeight, OpenContoursFindTheSideThatRises) {
   }
 }
 
+// A side the user named is the side h is measured on: named wrongly, the estimate does not take the
+// relief's height from the other side (it stays on the flat background and finds no step there).
+TEST(StepHeight, OpenContoursMeasureTheSideTheUserNamed) {
+  const syn::Scan scan = blended_open_scan();
+  const Mesh mesh = syn::to_mesh(scan);
+  const syn::Picks picks = scan.picks();
+  std::vector<int> vertices(picks.vertices.begin(), picks.vertices.end());
+  InitialContour initial = initial_contour(mesh, vertices, false);
+  ASSERT_TRUE(extend_to_boundary(mesh, &initial.path));
+  const bool relief_left = picks.relief_side == ReliefSide::Left;
+  StepHeightOptions named;
+  named.decide_side = false;
+  const StepHeightEstimate right = estimate_step_height(mesh, initial.path, false, relief_left, named);
+  EXPECT_EQ(right.relief_left, relief_left);
+  EXPECT_NEAR(right.value, scan.h, 0.33 * scan.h);
+  const StepHeightEstimate wrong = estimate_step_height(mesh, initial.path, false, !relief_left, named);
+  EXPECT_EQ(wrong.relief_left, !relief_left);
+  EXPECT_LT(wrong.value, 0.25 * scan.h);
+  EXPECT_LT(wrong.confidence, right.confidence);
+}
+
+// Open contours' further guesses start with the thin-plate fill of the background under the relief
+// side. Random scan 2032: a blended band on a wavy background, picked 2.2 h from it: the quadric
+// along the picks puts nothing above itself on the relief side (the first estimate finds no relief,
+// and the quadric over the wider strip guesses x0.2-x0.45); the fill follows the waves and its
+// first guess is within a quarter of h.
+TEST(StepHeight, OpenContoursGuessHOverTheFill) {
+  const syn::RandomScan random = syn::generate_random(2032);
+  ASSERT_FALSE(random.picks.closed);
+  const Mesh mesh = syn::to_mesh(random.scan);
+  std::vector<int> vertices(random.picks.vertices.begin(), random.picks.vertices.end());
+  InitialContour initial = initial_contour(mesh, vertices, false);
+  ASSERT_TRUE(extend_to_boundary(mesh, &initial.path));
+  const bool relief_left = random.picks.relief_side == ReliefSide::Left;
+  const double h = random.scan.h;
+  StepHeightOptions named;
+  named.decide_side = false;
+  const StepHeightEstimate first = estimate_step_height(mesh, initial.path, false, relief_left, named);
+  EXPECT_LT(first.value, 0.5 * h);
+  const std::vector<StepHeightGuess> guesses = alternative_step_heights(mesh, initial.path, false, relief_left, first);
+  ASSERT_GE(guesses.size(), 3u);
+  EXPECT_NE(guesses.front().source.find("filled in"), std::string::npos) << guesses.front().source;
+  EXPECT_GT(guesses.front().value, 0.75 * h);
+  EXPECT_LT(guesses.front().value, 1.33 * h);
+  for (const StepHeightGuess& g : guesses) {
+    if (g.source.find("wider strip") != std::string::npos) {
+      EXPECT_LT(g.value, 0.5 * h) << g.source;
+    }
+  }
+}
+
 // The further guesses (for when the first estimate's result fails): over a thin-plate fill of the
 // background a closed contour's guesses follow a vase's swell that one quadric over a plane misses
 // (random scan 115: a blended ellipse over most of the swell, where the first estimate is x7): one

@@ -196,6 +196,12 @@ struct Result {
   std::vector<Vec3> band_polyline;
 };
 
+/// A result on an open contour's decided side (Options::relief_side auto) that failed its self-check
+/// looks like the wrong side: under half the contour runs along a step, the step could not be
+/// measured, or the other side shows the clearer step (the checks step_share, measured_share,
+/// other_side_share). segment() then segments the other side too.
+bool looks_like_the_wrong_side(const Result& result);
+
 /// What the progress callback sees (valid only during the call).
 struct Progress {
   const char* phase = "";
@@ -223,6 +229,14 @@ class Segmenter {
                  const ProgressCallback& progress = {});
 
  private:
+  /// segment() for one relief side (given, or decided from the surface and reported in
+  /// side_decided as soon as it is known).
+  Result segment_one_side(const std::vector<std::int64_t>& picks, const Options& options,
+                          const ProgressCallback& progress, ReliefSide* side_decided = nullptr);
+  /// segment() of an open contour whose side is to be decided: the decided side, then the other
+  /// one when the decided side's result fails its self-check or the snake collapses on it.
+  Result segment_deciding_side(const std::vector<std::int64_t>& picks, const Options& options,
+                               const ProgressCallback& progress);
   struct Cache;
   const Mesh& mesh_;
   std::unique_ptr<Cache> cache_;

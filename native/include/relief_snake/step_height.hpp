@@ -13,8 +13,10 @@
 // When the segmentation at the first guess fails its self-check (or finds no step), segment()
 // tries further guesses (alternative_step_heights()): a quadric over a plane cannot follow a
 // vase's swell or a wave across a large contour, and the heights then do not split at the step.
-// For closed contours the background is the thin-plate fill (background.hpp) of the surface
-// outside the contour, continued under it; for open ones the strip compared is wider.
+// The background is the thin-plate fill (background.hpp) of the surface outside the contour,
+// continued under it (closed contours), or of the picks' side continued under the whole relief side
+// (open ones, whose heights are then taken over a strip along the picks three times as wide as the
+// first estimate's); for open contours the quadric over that wider strip follows.
 #include <string>
 #include <vector>
 
@@ -30,6 +32,9 @@ struct StepHeightOptions {
   double strip_share = 0.1;        ///< open contours: the strip compared on each side, as a share of the contour's length
   double fill_scale_edges = 3;     ///< further guesses, closed: the fill's length scale (ring 3x, smoothing 0.5x), in edges
   double wide_strip_share = 0.3;   ///< further guesses, open: the wider strip
+  /// Open contours: decide the relief side (the side that rises) and measure h on it; false: the
+  /// side is the caller's (inside_left, the user's --relief-side) and h is measured on that side.
+  bool decide_side = true;
 };
 
 struct StepHeightEstimate {
@@ -44,8 +49,8 @@ struct StepHeightEstimate {
 std::vector<int> contour_band_vertices(const Mesh& mesh, const SurfacePath& path, int rings);
 
 /// path: the initial contour (picks joined, open ones extended to the boundary).
-/// inside_left: closed contours' enclosed side (contour_orientation_left()); ignored for
-/// open contours, whose relief side is decided here (the side that rises).
+/// inside_left: closed contours' enclosed side (contour_orientation_left()); for open contours the
+/// relief side when options.decide_side is false, else ignored and decided here (the side that rises).
 StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& path, bool closed, bool inside_left,
                                         const StepHeightOptions& options = {});
 
@@ -56,12 +61,13 @@ struct StepHeightGuess {
 };
 
 /// Further guesses of h, in the order to try them (none <= 0, none over a quarter of the contour's
-/// size: length / pi closed, / 2 open): the median and the 90% height of
-/// the relief group over the other background (closed: the thin-plate fill of the surface outside
-/// the contour; open: the wider strip), and for open contours the 90% height of the relief side
-/// the first estimate measured. relief_left: the side decided (open) or enclosed (closed).
-/// Costs one sparse solve over the enclosed region for closed contours (0.1 to 0.7 s on the
-/// randomized suite's scans), so segment() asks only when the first guess failed.
+/// size: length / pi closed, / 2 open): the median and the 90% height of the relief group over the
+/// thin-plate fill of the background (closed: the region the contour encloses; open: the relief
+/// side, measured over the wider strip), and for open contours the same over the quadric of the
+/// wider strip and the 90% height of the relief side the first estimate measured. relief_left: the
+/// side decided or named (open) or enclosed (closed). Costs one sparse solve over the enclosed
+/// region or the relief side (0.1 to 0.7 s on the randomized suite's scans), so segment() asks only
+/// when the first guess failed.
 std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const SurfacePath& path, bool closed,
                                                       bool relief_left, const StepHeightEstimate& first,
                                                       const StepHeightOptions& options = {});
