@@ -41,7 +41,8 @@ def parse_args():
     p.add_argument("--truth", help="make-scan truth JSON: picks, h, open, relief_side (and IoU report)")
     p.add_argument("--w-int", type=float, default=None, help="smoothness in (0, 1]; default: the engine chooses")
     p.add_argument("--open", action="store_true", help="open contour ending on the mesh boundary")
-    p.add_argument("--side", choices=("left", "right"), default="left", help="relief side (open contours)")
+    p.add_argument("--side", choices=("auto", "left", "right"), default="auto",
+                   help="relief side of the picks (open contours; auto: the engine decides and says which)")
     p.add_argument("--out", required=True, help="output directory for the .blend and the .png")
     p.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
     p.add_argument("--resolution", type=int, nargs=2, default=(1280, 960))

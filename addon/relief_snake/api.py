@@ -75,7 +75,7 @@ def measure(obj, i, j):
     return pick_order.distance(mesh_io.vertex_position(obj.data, i), mesh_io.vertex_position(obj.data, j))
 
 
-def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
+def prepare(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="auto",
             max_iterations=3000, options=None, read_seconds=0.0, mesh=None):
     """Validate and read everything the engine needs (main thread, bpy access); writes nothing.
 
@@ -122,7 +122,7 @@ def mesh_changed(obj, request):
         return fingerprint(*mesh_io.read_buffers(mesh)) != request.digest
 
 
-def segment_object(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="left",
+def segment_object(obj, picks, step_height, *, w_int=None, open_contour=False, relief_side="auto",
                    max_iterations=3000, progress=None, write=True, group_name="Relief",
                    make_curve=True, options=None, cache=MESH_CACHE):
     """Segment the relief marked by `picks` (vertex indices, in order) on mesh object `obj`.

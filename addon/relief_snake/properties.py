@@ -10,6 +10,8 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, StringProperty
 
 SIDE_ITEMS = (
+    ('AUTO', "Auto", "The engine decides: the side of the picks that rises (it tries the other side when "
+                     "that one's result looks like a wrong side, and the summary names the side used)"),
     ('LEFT', "Left", "The relief lies left of the open outline, walking along the picks seen from outside"),
     ('RIGHT', "Right", "The relief lies right of the open outline, walking along the picks seen from outside"),
 )
@@ -52,7 +54,7 @@ def setting_properties(update=None):
             name="Open Outline", default=False,
             description="The relief runs off the edge of the mesh: the outline ends on the mesh's border", **kw),
         "relief_side": EnumProperty(
-            name="Relief Side", items=SIDE_ITEMS, default='LEFT',
+            name="Relief Side", items=SIDE_ITEMS, default='AUTO',
             description="Open outlines: which side of the picks the relief is on", **kw),
         "group_name": StringProperty(
             name="Group", default="Relief",

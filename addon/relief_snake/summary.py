@@ -26,7 +26,8 @@ PHASE_WORDS = {
 
 
 def result_summary(result):
-    """'Done: closed outline of 412 points, 5123 relief vertices, 1.9 s'."""
+    """'Done: closed outline of 412 points, 5123 relief vertices, 1.9 s'; an open outline names the
+    side of the picks its relief is on (given, or decided by the engine)."""
     contour = result.get("contour", [])
     relief = result.get("relief_vertices", [])
     status = str(result.get("status", "?"))
@@ -35,13 +36,15 @@ def result_summary(result):
     seconds = float(timing.get("total", timing.get("segment_seconds", 0.0)))
     kind = "closed" if result.get("closed", True) else "open"
     holes = len(result.get("holes") or [])
+    side = result.get("relief_side")
+    side_words = " (relief %s of the picks)" % side if kind == "open" and side in ("left", "right") else ""
     if result.get("band"):
         kind = "band with two"
     elif holes:
         kind += " (%d hole%s)" % (holes, "" if holes == 1 else "s")
-    return "%s: %s outline%s of %d points, %d relief vertices, %.1f s" % (
+    return "%s: %s outline%s of %d points%s, %d relief vertices, %.1f s" % (
         words[:1].upper() + words[1:], kind, "s" if result.get("band") else "",
-        len(contour), len(relief), seconds)
+        len(contour), side_words, len(relief), seconds)
 
 
 def status_warning(result):

@@ -12,7 +12,7 @@ __all__ = ["engine_arguments", "PAPER_W_INT"]
 PAPER_W_INT = 0.25
 
 
-def engine_arguments(num_picks, step_height, w_int=None, open_contour=False, relief_side="LEFT"):
+def engine_arguments(num_picks, step_height, w_int=None, open_contour=False, relief_side="AUTO"):
     """Check the settings; return (step_height, kwargs) for the engine.
 
     step_height: h > 0, or None to ask the engine to estimate it;
@@ -30,8 +30,8 @@ def engine_arguments(num_picks, step_height, w_int=None, open_contour=False, rel
     if w_int is not None and not (0 < w_int <= 1):
         raise ValueError("Smoothness must be between 0 and 1 (0.25 is the paper's value), or Auto")
     side = str(relief_side).lower()
-    if side not in ("left", "right"):
-        raise ValueError("Relief side must be LEFT or RIGHT")
+    if side not in ("auto", "left", "right"):
+        raise ValueError("Relief side must be AUTO, LEFT or RIGHT")
     h = None if step_height is None else float(step_height)
     return h, {"w_int": None if w_int is None else float(w_int), "open_contour": bool(open_contour),
                "relief_side": side}

@@ -982,6 +982,17 @@ class OpenContour(AddonTestCase):
         self.assertSegmentationMatchesTruth(self.obj, closed=False)
         self.assertEndsOnTheBorder(self.obj)
 
+    def test_auto_side_finds_the_relief_and_names_the_side(self):
+        # Relief Side Auto (the default): the engine decides the side from the surface, in either
+        # click order, and the summary says which side it used.
+        settings = bpy.context.scene.relief_snake
+        self.assertEqual(settings.bl_rna.properties["relief_side"].default, 'AUTO')
+        for picks, side in ((self.picks, self.side), (self.picks[::-1], self.other_side)):
+            select_vertices(self.obj, picks)
+            self.assertEqual(seg(step_height=self.h, open_contour=True, relief_side='AUTO'), {'FINISHED'})
+            self.assertSegmentationMatchesTruth(self.obj, closed=False)
+            self.assertIn("relief %s of the picks" % side.lower(), bpy.context.scene.relief_snake.last_summary)
+
     def test_wrong_side_does_not_find_the_relief_and_says_so(self):
         # Told the relief is on the other side, the snake deflates away from it over flat
         # background: the engine still returns a region (not the relief), and its self-check

@@ -31,6 +31,13 @@ class Summaries(unittest.TestCase):
         self.assertEqual(summary.result_summary(dict(RESULT, band=True, band_contour=[(0, 0, 0)] * 4)),
                          "Done: band with two outlines of 5 points, 3 relief vertices, 2.5 s")
 
+    def test_open_outlines_name_the_relief_side(self):
+        # The side used (given, or decided by the engine) is part of the answer for an open outline.
+        self.assertEqual(summary.result_summary(dict(RESULT, closed=False, relief_side="right")),
+                         "Done: open outline of 5 points (relief right of the picks), 3 relief vertices, 2.5 s")
+        self.assertEqual(summary.result_summary(dict(RESULT, relief_side="left")),
+                         "Done: closed outline of 5 points, 3 relief vertices, 2.5 s")
+
     def test_converged_has_no_warning(self):
         self.assertIsNone(summary.status_warning(RESULT))
 

@@ -12,6 +12,8 @@ class EngineArguments(unittest.TestCase):
         self.assertEqual(h, 1.5)
         self.assertEqual(kw, {"w_int": 0.3, "open_contour": False, "relief_side": "right"})
         self.assertTrue(validation.engine_arguments(2, 1.0, open_contour=True)[1]["open_contour"])
+        # The side is the engine's to decide unless the artist names it.
+        self.assertEqual(validation.engine_arguments(2, 1.0, open_contour=True)[1]["relief_side"], "auto")
 
     def test_auto_smoothness_and_estimated_step_height_pass_none(self):
         h, kw = validation.engine_arguments(3, None, None)
