@@ -7,7 +7,7 @@
 # Environment: BUILD_DIR [build], PYTHON [python3], JOBS [2] (build), BENCH_JOBS [2] (parallel
 # runs), BENCH_ARGS (extra arguments for run_bench.py, e.g. --quick or --keep-scans),
 # BENCH_SECTIONS ["main random extract whole detect"], RANDOM_SEEDS [0:200], RANDOM_ARGS (extra arguments for
-# random_suite.py, e.g. --variant NAME=OPTIONS; without --variant it runs defaults, paper, old-defaults).
+# random_suite.py, e.g. --variant NAME=OPTIONS; without --variant it runs defaults, paper, auto-h, auto-side, old-defaults).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
