@@ -158,8 +158,6 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
     for (const int v : fill.region_vertices)
       if (closed || near[v]) heights.push_back({fill.height[v], mesh.vertex_area(v)});
     relief_group_guesses(heights, options, "the background filled in from around the picks", &out);
-  } else if (closed) {
-    return out;
   }
   if (!closed) {
     const QuadraticBackground background = fit_background(mesh, samples);
