@@ -240,6 +240,15 @@ static syn::Scan blended_open_scan() {
   return syn::generate(spec);
 }
 
+// The initial contour of open picks, extended to the mesh boundary as segment() extends it (empty
+// when it cannot reach the boundary).
+static SurfacePath extended_open_path(const Mesh& mesh, const std::vector<std::int64_t>& picks) {
+  const std::vector<int> vertices(picks.begin(), picks.end());
+  InitialContour initial = initial_contour(mesh, vertices, false);
+  if (!extend_to_boundary(mesh, &initial.path)) return {};
+  return initial.path;
+}
+
 TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {
   for (const auto background : {syn::Background::Plane, syn::Background::Cylinder, syn::Background::Sphere})
     for (const auto step : {syn::Step::Sharp, syn::Step::Blended})
@@ -264,10 +273,9 @@ TEST(StepHeight, OpenContoursFindTheSideThatRises) {
     syn::PickSpec ps;
     ps.reverse = reverse;
     const syn::Picks picks = scan.picks(ps);
-    std::vector<int> vertices(picks.vertices.begin(), picks.vertices.end());
-    InitialContour initial = initial_contour(mesh, vertices, false);
-    ASSERT_TRUE(extend_to_boundary(mesh, &initial.path));
-    const StepHeightEstimate e = estimate_step_height(mesh, initial.path, false, true);
+    const SurfacePath path = extended_open_path(mesh, picks.vertices);
+    ASSERT_FALSE(path.empty());
+    const StepHeightEstimate e = estimate_step_height(mesh, path, false, true);
     EXPECT_EQ(e.relief_left, picks.relief_side == ReliefSide::Left) << "reverse " << reverse;
     EXPECT_NEAR(e.value, scan.h, 0.33 * scan.h);
   }
@@ -279,16 +287,15 @@ TEST(StepHeight, OpenContoursMeasureTheSideTheUserNamed) {
   const syn::Scan scan = blended_open_scan();
   const Mesh mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks();
-  std::vector<int> vertices(picks.vertices.begin(), picks.vertices.end());
-  InitialContour initial = initial_contour(mesh, vertices, false);
-  ASSERT_TRUE(extend_to_boundary(mesh, &initial.path));
+  const SurfacePath path = extended_open_path(mesh, picks.vertices);
+  ASSERT_FALSE(path.empty());
   const bool relief_left = picks.relief_side == ReliefSide::Left;
   StepHeightOptions named;
   named.decide_side = false;
-  const StepHeightEstimate right = estimate_step_height(mesh, initial.path, false, relief_left, named);
+  const StepHeightEstimate right = estimate_step_height(mesh, path, false, relief_left, named);
   EXPECT_EQ(right.relief_left, relief_left);
   EXPECT_NEAR(right.value, scan.h, 0.33 * scan.h);
-  const StepHeightEstimate wrong = estimate_step_height(mesh, initial.path, false, !relief_left, named);
+  const StepHeightEstimate wrong = estimate_step_height(mesh, path, false, !relief_left, named);
   EXPECT_EQ(wrong.relief_left, !relief_left);
   EXPECT_LT(wrong.value, 0.25 * scan.h);
   EXPECT_LT(wrong.confidence, right.confidence);
@@ -303,16 +310,15 @@ TEST(StepHeight, OpenContoursGuessHOverTheFill) {
   const syn::RandomScan random = syn::generate_random(2032);
   ASSERT_FALSE(random.picks.closed);
   const Mesh mesh = syn::to_mesh(random.scan);
-  std::vector<int> vertices(random.picks.vertices.begin(), random.picks.vertices.end());
-  InitialContour initial = initial_contour(mesh, vertices, false);
-  ASSERT_TRUE(extend_to_boundary(mesh, &initial.path));
+  const SurfacePath path = extended_open_path(mesh, random.picks.vertices);
+  ASSERT_FALSE(path.empty());
   const bool relief_left = random.picks.relief_side == ReliefSide::Left;
   const double h = random.scan.h;
   StepHeightOptions named;
   named.decide_side = false;
-  const StepHeightEstimate first = estimate_step_height(mesh, initial.path, false, relief_left, named);
+  const StepHeightEstimate first = estimate_step_height(mesh, path, false, relief_left, named);
   EXPECT_LT(first.value, 0.5 * h);
-  const std::vector<StepHeightGuess> guesses = alternative_step_heights(mesh, initial.path, false, relief_left, first);
+  const std::vector<StepHeightGuess> guesses = alternative_step_heights(mesh, path, false, relief_left, first);
   ASSERT_GE(guesses.size(), 3u);
   EXPECT_NE(guesses.front().source.find("filled in"), std::string::npos) << guesses.front().source;
   EXPECT_GT(guesses.front().value, 0.75 * h);
@@ -351,13 +357,12 @@ TEST(StepHeight, FurtherGuessesFollowTheBackgroundTheQuadricMisses) {
   const syn::Scan scan = blended_open_scan();
   const Mesh open_mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks();
-  std::vector<int> open_vertices(picks.vertices.begin(), picks.vertices.end());
-  InitialContour open_initial = initial_contour(open_mesh, open_vertices, false);
-  ASSERT_TRUE(extend_to_boundary(open_mesh, &open_initial.path));
+  const SurfacePath open_path = extended_open_path(open_mesh, picks.vertices);
+  ASSERT_FALSE(open_path.empty());
   const bool relief_left = picks.relief_side == ReliefSide::Left;
-  const StepHeightEstimate open_first = estimate_step_height(open_mesh, open_initial.path, false, relief_left);
+  const StepHeightEstimate open_first = estimate_step_height(open_mesh, open_path, false, relief_left);
   const std::vector<StepHeightGuess> open_guesses =
-      alternative_step_heights(open_mesh, open_initial.path, false, open_first.relief_left, open_first);
+      alternative_step_heights(open_mesh, open_path, false, open_first.relief_left, open_first);
   ASSERT_GE(open_guesses.size(), 2u);
   EXPECT_NEAR(open_guesses.front().value, scan.h, 0.33 * scan.h);
 }
