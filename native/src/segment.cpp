@@ -46,8 +46,9 @@ const char* to_string(Status status) {
   return "unknown";
 }
 
-bool refit_wanted(double found, double h_used, const std::vector<double>& tried, const Options& options) {
-  if (!(found > 0) || !(h_used > 0)) return false;
+bool refit_wanted(double found, double h_used, const std::vector<double>& tried, const Options& options,
+                  double largest) {
+  if (!(found > 0) || !(h_used > 0) || found > largest) return false;
   const double ratio = found / h_used;
   if (ratio < std::min(options.refit_ratio_up, options.refit_ratio) && ratio * options.refit_ratio > 1) return false;
   for (const double t : tried)
@@ -231,9 +232,12 @@ double check_named(const Result& result, const std::string& name, double none) {
 // the right side, and the other side's background could only give a wrong region (one that, on
 // striations, can even pass the self-check: random scan 1014 did with every failed side swapped).
 bool looks_like_the_wrong_side(const Result& result) {
-  const double step_share = check_named(result, "step_share", 0.0);
-  return step_share < 0.5 || check_named(result, "measured_share", 0.0) < SelfCheckOptions().min_measured_share ||
-         check_named(result, "other_side_share", 0.0) > step_share;
+  return looks_like_the_wrong_side(check_named(result, "step_share", 0.0), check_named(result, "measured_share", 0.0),
+                                   check_named(result, "other_side_share", 0.0));
+}
+
+bool looks_like_the_wrong_side(double step_share, double measured_share, double other_side_share) {
+  return step_share < 0.5 || measured_share < SelfCheckOptions().min_measured_share || other_side_share > step_share;
 }
 
 // An open contour's relief side decided from the surface (step_height.hpp: the side that rises
@@ -242,52 +246,85 @@ bool looks_like_the_wrong_side(const Result& result) {
 // background, which the self-check flags (a contour off any step, a clearer step from the other
 // side). So when the decided side's result fails its self-check that way, or the snake collapses on
 // it, the other side is segmented too, and kept if its result passes the self-check.
+//
+// Each side is first only probed: its result at the first h (with that h's refits). When the decided
+// side's probe fails as a wrong side does, the other side's probe follows, and a result of it that
+// passes the self-check is kept. Otherwise both sides get their full search (the further guesses of
+// h), the decided side first, as without the probes. A wrong side's guesses of h (a curved background
+// read as a step at ever larger h) took most of the time of a failing open contour, and a result they
+// found could hide that the side was wrong.
 Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, const Options& options,
                                         const ProgressCallback& progress) {
-  Result first;
-  std::string first_error;
+  struct SideRun {
+    Result result;
+    std::string error;
+    bool probe_failed = false;
+    bool usable() const { return error.empty(); }
+    bool passes() const { return error.empty() && result.status == Status::Converged; }
+    bool final() const {  // kept without looking at the other side
+      return error.empty() && !probe_failed &&
+             (result.status == Status::Converged || result.status == Status::Cancelled ||
+              !looks_like_the_wrong_side(result));
+    }
+  };
   ReliefSide decided = ReliefSide::Auto;
-  try {
-    first = segment_one_side(picks, options, progress, &decided);
-    if (first.status == Status::Converged || first.status == Status::Cancelled || !looks_like_the_wrong_side(first))
-      return first;
-  } catch (const Error& e) {
-    first_error = e.what();
-  }
+  auto run_side = [&](const Options& side_options, bool probe) {
+    SideRun run;
+    try {
+      run.result = segment_one_side(picks, side_options, progress,
+                                    side_options.relief_side == ReliefSide::Auto ? &decided : nullptr,
+                                    probe ? &run.probe_failed : nullptr);
+    } catch (const Error& e) {
+      run.error = e.what();
+    }
+    return run;
+  };
+  SideRun first = run_side(options, true);
+  if (first.final()) return first.result;
   // An error before the side was decided (bad picks, a mesh without boundary) is the other side's too.
-  if (decided == ReliefSide::Auto) throw Error(first_error);
+  if (decided == ReliefSide::Auto) throw Error(first.error);
   Options other = options;
   const bool first_left = decided == ReliefSide::Left;
   other.relief_side = first_left ? ReliefSide::Right : ReliefSide::Left;
   const char* first_name = first_left ? "left" : "right";
   const char* other_name = first_left ? "right" : "left";
-  Result second;
-  try {
-    second = segment_one_side(picks, other, progress);
-  } catch (const Error&) {
-    if (!first_error.empty()) throw Error(first_error);
-    first.notes.push_back(std::string("the other side (") + other_name + ") was tried too: it gave no result");
-    return first;
+  SideRun second = run_side(other, first.probe_failed);
+  if (second.usable() && second.result.status == Status::Cancelled) return second.result;
+  if (first.probe_failed && !second.passes()) {
+    // Neither probe gives a result that passes: both sides' full searches, the decided side first.
+    first = run_side(options, false);
+    if (first.final()) return first.result;
+    if (second.probe_failed) {
+      second = run_side(other, false);
+      if (second.usable() && second.result.status == Status::Cancelled) return second.result;
+    }
   }
-  if (second.status == Status::Cancelled) return second;
-  const std::string why = first_error.empty() ? "its result failed the self-check (" +
-                                                    (first.reasons.empty() ? first.message : first.reasons.front()) + ")"
-                                              : "it gave no result (" + first_error + ")";
-  if (second.status == Status::Converged || !first_error.empty()) {
-    second.notes.insert(second.notes.begin(), std::string("the relief side was decided from the surface as ") +
-                                                  first_name + " of the picks, but " + why + "; the " + other_name +
-                                                  " side was segmented instead");
-    second.attempts += first.attempts;
-    return second;
+  if (!second.usable()) {
+    if (!first.usable()) throw Error(first.error);
+    first.result.notes.push_back(std::string("the other side (") + other_name + ") was tried too: it gave no result");
+    return first.result;
   }
-  first.notes.push_back(std::string("the other side (") + other_name +
-                        ") was tried too and its result failed the self-check as well");
-  first.attempts += second.attempts;
-  return first;
+  if (second.passes() || !first.usable()) {
+    const std::string why =
+        !first.usable() ? "it gave no result (" + first.error + ")"
+        : first.probe_failed && first.result.reasons.empty()
+            ? std::string("the snake collapsed on it at the first h")
+            : "its result failed the self-check (" +
+                  (first.result.reasons.empty() ? first.result.message : first.result.reasons.front()) + ")";
+    second.result.notes.insert(second.result.notes.begin(),
+                               std::string("the relief side was decided from the surface as ") + first_name +
+                                   " of the picks, but " + why + "; the " + other_name + " side was segmented instead");
+    second.result.attempts += first.result.attempts;
+    return second.result;
+  }
+  first.result.notes.push_back(std::string("the other side (") + other_name +
+                               ") was tried too and its result failed the self-check as well");
+  first.result.attempts += second.result.attempts;
+  return first.result;
 }
 
 Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const Options& options,
-                                   const ProgressCallback& progress, ReliefSide* side_decided) {
+                                   const ProgressCallback& progress, ReliefSide* side_decided, bool* probe_failed) {
   const auto t_start = Clock::now();
   const Mesh& mesh = mesh_;
   const std::vector<int> pick_vertices = validate_picks(mesh, picks, options.closed);
@@ -628,12 +665,13 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   };
   // One h, then the refit along the contour; the notes go to the result if it is kept.
   std::vector<double> tried;
+  const double largest_h = largest_plausible_step_height(mesh, initial.path, options.closed);
   auto attempt_with_refits = [&](double h_first, std::vector<std::string>* notes) {
     Attempt kept = attempt_at(h_first);
     tried.push_back(h_first);
     for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && kept.usable(); ++refit) {
       const double found = kept.evidence.step.step_height;
-      if (!refit_wanted(found, kept.h, tried, options)) break;
+      if (!refit_wanted(found, kept.h, tried, options, largest_h)) break;
       tried.push_back(found);
       Attempt next = attempt_at(found);
       if (cancelled) break;
@@ -653,6 +691,19 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   std::vector<std::string> h_notes;
   Attempt best;
   if (h > 0) best = attempt_with_refits(h, &h_notes);
+  // A side being probed (segment_deciding_side) whose first h fails as a wrong side does, or collapses,
+  // and that has further guesses of h to leave for later (a given h has none: its search is done).
+  if (probe_failed && !h_given && options.retry_estimate != EstimateRetry::Off && h > 0 && !cancelled &&
+      (!best.usable() || (!best.check.holds && looks_like_the_wrong_side(best.evidence.step.step_share,
+                                                                         best.evidence.step.measured_share(),
+                                                                         best.evidence.other_side_share)))) {
+    *probe_failed = true;
+    Result probe;
+    probe.status = Status::Doubtful;
+    probe.attempts = result.attempts;
+    if (best.usable()) probe.reasons = best.check.reasons;  // none: the snake collapsed
+    return probe;
+  }
   // An estimated h that gives no result (or, unless retry_estimate=no_result, one that fails the
   // self-check): the estimator's further guesses, each with its refit, the best evidence kept.
   // Guesses within x1.3 of an h tried already would find the same contour.

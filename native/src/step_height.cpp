@@ -132,8 +132,12 @@ StepHeightEstimate estimate_step_height(const Mesh& mesh, const SurfacePath& pat
   const double above_noise = std::clamp(value / (10 * background.residual + 1e-300) , 0.0, 1.0);
   estimate.confidence = clean * above_noise;
   // A step a sizeable part of the contour's own size is no relief step: unsure.
-  if (value > 0.25 * contour_size(mesh, path, closed)) estimate.confidence = 0;
+  if (value > largest_plausible_step_height(mesh, path, closed)) estimate.confidence = 0;
   return estimate;
+}
+
+double largest_plausible_step_height(const Mesh& mesh, const SurfacePath& path, bool closed) {
+  return 0.25 * contour_size(mesh, path, closed);
 }
 
 std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const SurfacePath& path, bool closed,
@@ -167,8 +171,8 @@ std::vector<StepHeightGuess> alternative_step_heights(const Mesh& mesh, const Su
   }
   // A step a sizeable part of the contour's own size is the background's own curvature (as for the
   // first estimate, whose confidence it zeroes).
-  const double size = contour_size(mesh, path, closed);
-  out.erase(std::remove_if(out.begin(), out.end(), [&](const StepHeightGuess& g) { return g.value > 0.25 * size; }),
+  const double largest = largest_plausible_step_height(mesh, path, closed);
+  out.erase(std::remove_if(out.begin(), out.end(), [&](const StepHeightGuess& g) { return g.value > largest; }),
             out.end());
   return out;
 }

@@ -263,6 +263,8 @@ TEST(StepHeight, EstimatedFromThePicksWithinAQuarter) {
         EXPECT_GT(e.value, 0.75 * h) << syn::to_string(background) << " " << syn::to_string(step) << " h " << h;
         EXPECT_LT(e.value, 1.33 * h) << syn::to_string(background) << " " << syn::to_string(step) << " h " << h;
         EXPECT_GT(e.confidence, 0.3);
+        // The true step is well within what the picks make plausible (a quarter of their diameter).
+        EXPECT_GT(largest_plausible_step_height(mesh, initial.path, true), 2 * h);
       }
 }
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -130,9 +131,10 @@ struct Options {
 };
 
 /// The step found along a contour segmented with h_used calls for segmenting again with it: it
-/// is above h_used by refit_ratio_up (or refit_ratio, if less) or below it by refit_ratio, and not within x1.15 of an h
-/// already tried.
-bool refit_wanted(double found, double h_used, const std::vector<double>& tried, const Options& options);
+/// is above h_used by refit_ratio_up (or refit_ratio, if less) or below it by refit_ratio, not within x1.15 of an h
+/// already tried, and not above `largest` (largest_plausible_step_height() of the picks).
+bool refit_wanted(double found, double h_used, const std::vector<double>& tried, const Options& options,
+                  double largest = std::numeric_limits<double>::infinity());
 
 enum class Status {
   Converged,      ///< every phase stopped because nothing moved any more, and the self-check holds (evidence.hpp)
@@ -201,6 +203,8 @@ struct Result {
 /// measured, or the other side shows the clearer step (the checks step_share, measured_share,
 /// other_side_share). segment() then segments the other side too.
 bool looks_like_the_wrong_side(const Result& result);
+/// The same from the three checks' values (other_side_share -1 when not measured).
+bool looks_like_the_wrong_side(double step_share, double measured_share, double other_side_share);
 
 /// What the progress callback sees (valid only during the call).
 struct Progress {
@@ -230,9 +234,12 @@ class Segmenter {
 
  private:
   /// segment() for one relief side (given, or decided from the surface and reported in
-  /// side_decided as soon as it is known).
+  /// side_decided as soon as it is known). With probe_failed, a probe of that side: when the
+  /// result at the first h fails as a wrong side does (looks_like_the_wrong_side) or the snake
+  /// collapses, *probe_failed is set and an empty result returned, without the further guesses of h.
   Result segment_one_side(const std::vector<std::int64_t>& picks, const Options& options,
-                          const ProgressCallback& progress, ReliefSide* side_decided = nullptr);
+                          const ProgressCallback& progress, ReliefSide* side_decided = nullptr,
+                          bool* probe_failed = nullptr);
   /// segment() of an open contour whose side is to be decided: the decided side, then the other
   /// one when the decided side's result fails its self-check or the snake collapses on it.
   Result segment_deciding_side(const std::vector<std::int64_t>& picks, const Options& options,
