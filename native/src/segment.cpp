@@ -236,6 +236,10 @@ bool looks_like_the_wrong_side(const Result& result) {
                                    check_named(result, "other_side_share", 0.0));
 }
 
+// An open contour's side decided with the other side rising at least this share as much along the
+// picks (StepHeightEstimate::left_rise/right_rise) is checked against the other side's result.
+constexpr double kAmbiguousSideRise = 0.5;
+
 bool looks_like_the_wrong_side(double step_share, double measured_share, double other_side_share) {
   return step_share < 0.5 || measured_share < SelfCheckOptions().min_measured_share || other_side_share > step_share;
 }
@@ -280,14 +284,41 @@ Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, 
     return run;
   };
   SideRun first = run_side(options, true);
-  if (first.final()) return first.result;
   // An error before the side was decided (bad picks, a mesh without boundary) is the other side's too.
-  if (decided == ReliefSide::Auto) throw Error(first.error);
+  if (!first.final() && decided == ReliefSide::Auto) throw Error(first.error);
   Options other = options;
   const bool first_left = decided == ReliefSide::Left;
   other.relief_side = first_left ? ReliefSide::Right : ReliefSide::Left;
   const char* first_name = first_left ? "left" : "right";
   const char* other_name = first_left ? "right" : "left";
+  if (first.final()) {
+    // Both sides rise along the picks (picks along a groove, or between two levels): if the other side
+    // also gives a relief that passes the self-check, which one the user meant is a guess.
+    const double other_rise = check_named(first.result, "other_side_rise", 0.0);
+    if (first.passes() && other_rise >= kAmbiguousSideRise) {
+      // At this side's h when it was estimated: the other side's own estimate is a guess too (between
+      // two levels the step is the same; on the real eyebrow scan's lower edge the estimate for the
+      // other side was x2.3 of its step, and that side failed only for it).
+      Options alternative_options = other;
+      if (!(options.step_height > 0)) alternative_options.step_height = first.result.parameters.step_height;
+      const SideRun alternative = run_side(alternative_options, true);
+      if (alternative.usable() && alternative.result.status == Status::Cancelled) return alternative.result;
+      first.result.attempts += alternative.result.attempts;
+      if (alternative.passes()) {
+        Result& r = first.result;
+        r.status = Status::Doubtful;
+        r.reasons.push_back(std::string("both sides of the picks rise above the background (the ") + other_name +
+                            " side " + fmt(100 * other_rise, 2) + "% as much as the " + first_name +
+                            ") and each gives a relief that passes the self-check: this is the one on the " +
+                            first_name + "; if the relief is on the " + other_name + ", give the side");
+        r.message = "Check this result: " + r.reasons.back() + ".";
+      } else {
+        first.result.notes.push_back(std::string("the ") + other_name + " side rises too (" + fmt(100 * other_rise, 2) +
+                                     "% as much) but gives no relief that passes the self-check");
+      }
+    }
+    return first.result;
+  }
   SideRun second = run_side(other, first.probe_failed);
   if (second.usable() && second.result.status == Status::Cancelled) return second.result;
   if (first.probe_failed && !second.passes()) {
@@ -832,6 +863,12 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   if (best.evidence.coarse_relief_kept >= 0)
     result.checks.push_back({"coarse_relief_kept", best.evidence.coarse_relief_kept});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
+  if (!side_given) {
+    // The side decision's margin: the side not taken's rise along the picks over the side taken's.
+    const double taken = inside_left ? estimate.left_rise : estimate.right_rise;
+    const double other_rise = inside_left ? estimate.right_rise : estimate.left_rise;
+    if (taken > 0) result.checks.push_back({"other_side_rise", std::max(other_rise, 0.0) / taken});
+  }
   result.reasons = best.check.reasons;
   if (!second_guess_reason.empty() && result.reasons.empty()) result.reasons.push_back(second_guess_reason);
   if (options.closed) {
