@@ -236,13 +236,13 @@ bool looks_like_the_wrong_side(const Result& result) {
                                    check_named(result, "other_side_share", 0.0));
 }
 
-// An open contour's side decided with the other side rising at least this share as much along the
-// picks (StepHeightEstimate::left_rise/right_rise) is checked against the other side's result.
-constexpr double kAmbiguousSideRise = 0.5;
-
 bool looks_like_the_wrong_side(double step_share, double measured_share, double other_side_share) {
   return step_share < 0.5 || measured_share < SelfCheckOptions().min_measured_share || other_side_share > step_share;
 }
+
+// An open contour's side decided with the other side rising at least this share as much along the
+// picks (StepHeightEstimate::left_rise/right_rise) is checked against the other side's result.
+constexpr double kAmbiguousSideRise = 0.5;
 
 // An open contour's relief side decided from the surface (step_height.hpp: the side that rises
 // along the picks) can be wrong: the strip compared may not reach a relief picked far from it, or
@@ -265,6 +265,7 @@ Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, 
     bool probe_failed = false;
     bool usable() const { return error.empty(); }
     bool passes() const { return error.empty() && result.status == Status::Converged; }
+    bool cancelled() const { return error.empty() && result.status == Status::Cancelled; }
     bool final() const {  // kept without looking at the other side
       return error.empty() && !probe_failed &&
              (result.status == Status::Converged || result.status == Status::Cancelled ||
@@ -302,7 +303,7 @@ Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, 
       Options alternative_options = other;
       if (!(options.step_height > 0)) alternative_options.step_height = first.result.parameters.step_height;
       const SideRun alternative = run_side(alternative_options, true);
-      if (alternative.usable() && alternative.result.status == Status::Cancelled) return alternative.result;
+      if (alternative.cancelled()) return alternative.result;
       first.result.attempts += alternative.result.attempts;
       if (alternative.passes()) {
         Result& r = first.result;
@@ -320,14 +321,14 @@ Result Segmenter::segment_deciding_side(const std::vector<std::int64_t>& picks, 
     return first.result;
   }
   SideRun second = run_side(other, first.probe_failed);
-  if (second.usable() && second.result.status == Status::Cancelled) return second.result;
+  if (second.cancelled()) return second.result;
   if (first.probe_failed && !second.passes()) {
     // Neither probe gives a result that passes: both sides' full searches, the decided side first.
     first = run_side(options, false);
     if (first.final()) return first.result;
     if (second.probe_failed) {
       second = run_side(other, false);
-      if (second.usable() && second.result.status == Status::Cancelled) return second.result;
+      if (second.cancelled()) return second.result;
     }
   }
   if (!second.usable()) {
