@@ -49,7 +49,11 @@ TEST(Foot, MovesASnakeFromTheSlopeOutToTheFoot) {
   o.h = scan.h;
   const FootResult r = settle_at_foot(&snake, o);
   EXPECT_FALSE(r.noisy);
-  EXPECT_GT(r.moved, 120);  // most of the 150
+  // Most of the 150. Not all: walked obliquely from this jagged snake (through the vertices
+  // nearest the circle), some bands reach onto the slope (residual 0.02 h), and read at those
+  // snaxels their fits cannot tell the slope from the background (118 moved; 123 before the
+  // threshold allowed for the fit's error).
+  EXPECT_GT(r.moved, 110);
   EXPECT_NEAR(mean_radius(snake), 12.0, 0.1);
   // Already at the foot: (almost) nothing moves.
   Snake outside = circle_snake(mesh, scan, 12.3, 150);
@@ -67,7 +71,7 @@ TEST(Foot, LeavesAContourMostlyWithoutCleanBackgroundAlone) {
   Snake snake = circle_snake(mesh, scan, 11.75, 150);
   const FootResult clean = settle_at_foot(&snake, o);
   EXPECT_FALSE(clean.unclean);
-  EXPECT_GT(clean.moved, 120);
+  EXPECT_GT(clean.moved, 110);  // as in MovesASnakeFromTheSlopeOutToTheFoot
   // A band beyond the mesh's edge for every snaxel: no clean background anywhere.
   o.band_from = 30;
   o.band_to = 40;
@@ -95,3 +99,4 @@ TEST(Foot, LeavesANoisyBackgroundAlone) {
   EXPECT_EQ(r.moved, 0);
   EXPECT_EQ(mean_radius(snake), before);
 }
+

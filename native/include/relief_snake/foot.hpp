@@ -61,9 +61,11 @@ WallResult settle_down_walls(const Mesh& mesh, std::vector<SurfacePoint>* contou
                              const WallOptions& options = {});
 
 /// For each snaxel of `snake`, walks outwards along the surface, fits the background
-/// (a quadratic profile over the band) and finds the outermost point inside the band
-/// where the surface rises above it by more than a threshold (4 times the band's
-/// residual, at least 0.02 h): the foot. Moves the snaxel out to it (median-filtered
+/// (a quadratic profile over the band, a straight one where the band shows no significant
+/// curvature) and finds the outermost point inside the band where the surface rises above
+/// it by more than a threshold (4 times the standard deviation of the fit's prediction there:
+/// the band's residual, grown by the fit's leverage where it is extrapolated; at least
+/// 0.02 h): the foot. Moves the snaxel out to it (median-filtered
 /// along the snake). Snaxels with no clean background band are left where they are.
 FootResult settle_at_foot(Snake* snake, const FootOptions& options);
 
