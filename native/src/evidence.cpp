@@ -105,6 +105,8 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   // Per measured profile: (distance inwards, height) of the inside vertices in a strip across
   // the contour, for the offset to the step once the step height is known.
   std::vector<std::vector<std::pair<double, double>>> strips;
+  // The same strips with the outside vertices too, for the width of the rise.
+  std::vector<std::vector<std::pair<double, double>>> whole_strips;
 
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
   std::vector<double> heights;
@@ -189,11 +191,13 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       if (inward.dot(inside_mean) < 0) inward = -inward;
       heights.clear();
       strips.emplace_back();
+      whole_strips.emplace_back();
       for (const int v : ball) {
-        if (!region[v]) continue;
         const Vec3 d = mesh.position(v) - centre;
         const double across = d.dot(inward), along = d.dot(tangent);
         const double height = (mesh.position(v) - mean).dot(normal);
+        if (std::fabs(along) <= strip_half_width) whole_strips.back().push_back({across, height});
+        if (!region[v]) continue;
         if (across >= front_from && across <= front_to && std::fabs(along) <= front_half_width)
           heights.push_back(height);
         if (std::fabs(along) <= strip_half_width) strips.back().push_back({across, height});
@@ -205,6 +209,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       profile.foot_gap = foot_gap(centre, inward, tangent, profile.rise);
     } else {
       strips.emplace_back();
+      whole_strips.emplace_back();
     }
     evidence.profiles.push_back(profile);
   }
@@ -269,6 +274,27 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     evidence.foot_gap_median = quantile(gaps, 0.5);
     evidence.foot_gap_q75 = quantile(gaps, 0.75);
     evidence.longest_far = far_run.length * spacing;
+    // The width of the rise across each on-step profile: from the outermost one-edge bin whose median
+    // stands a quarter of the step high to the outermost at three quarters.
+    std::vector<double> widths;
+    std::vector<std::vector<double>> bins(2 * static_cast<std::size_t>(radius / edge) + 2);
+    for (std::size_t k = 0; k < evidence.profiles.size(); ++k) {
+      if (!evidence.profiles[k].on_step) continue;
+      for (auto& bin : bins) bin.clear();
+      for (const auto& [across, height] : whole_strips[k]) {
+        const long b = static_cast<long>(std::floor(across / edge)) + static_cast<long>(bins.size() / 2);
+        if (b >= 0 && b < static_cast<long>(bins.size())) bins[b].push_back(height);
+      }
+      double quarter = -1, three_quarters = -1;
+      for (std::size_t b = 0; b < bins.size(); ++b) {
+        if (bins[b].empty()) continue;
+        const double median = quantile(bins[b], 0.5);
+        if (quarter < 0 && median >= 0.25 * evidence.step_height) quarter = double(b);
+        if (three_quarters < 0 && median >= 0.75 * evidence.step_height) three_quarters = double(b);
+      }
+      if (quarter >= 0 && three_quarters >= quarter) widths.push_back((three_quarters - quarter) * edge);
+    }
+    evidence.rise_width_median = quantile(widths, 0.5);
   }
   return evidence;
 }

@@ -151,13 +151,17 @@ struct Attempt {
 };
 
 // The contour sits on a blended step over a clean background: half the step lies at least 1.5
-// average edges inside it (StepEvidence::offset_median), and the outside planes' residual is under
-// 5% of h. There the feature energy holds the snake part of the way up the slope, and the foot stage
-// brings it down to the foot; on sharp steps (already at the foot), textured or noisy backgrounds
-// (where the foot test fires on the texture) and coarse meshes it only moved right contours off
-// (randomized suite, docs/design.md).
+// average edges inside it (StepEvidence::offset_median) or, with h at least 3 edges, the step rises
+// over at least 2 edges from a quarter to three quarters of its height (StepEvidence::
+// rise_width_median: a sharp or one-triangle step rises within one; on a coarser mesh one-edge bins
+// cannot tell them apart), and the outside planes' residual is under 5% of h. There the
+// feature energy holds the snake part of the way up the slope, and the foot stage brings it down to
+// the foot; on sharp steps (already at the foot), textured or noisy backgrounds (where the foot test
+// fires on the texture) and coarse meshes it only moved right contours off (randomized suite,
+// docs/design.md).
 bool blended_and_clean(const StepEvidence& step, double h, double edge) {
-  return step.step_share > 0 && step.offset_median >= 1.5 * edge && step.background_residual <= 0.05 * h;
+  const bool wide_rise = step.rise_width_median >= 2 * edge && h >= 3 * edge;
+  return step.step_share > 0 && (step.offset_median >= 1.5 * edge || wide_rise) && step.background_residual <= 0.05 * h;
 }
 
 // a is better evidence than b.
@@ -859,6 +863,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
                    {"far_run", step.longest_far / best.h},
                    {"foot_gap_median", step.foot_gap_median / best.h},
                    {"foot_gap_q75", step.foot_gap_q75 / best.h},
+                   {"rise_width", step.rise_width_median / best.h},
                    {"background_depth", best.evidence.background_depth},
                    {"background_area", best.evidence.background_area}});
   if (best.evidence.coarse_relief_kept >= 0)

@@ -480,6 +480,26 @@ TEST(SegmentFoot, TheFootStageDoesNotOvershootOnANoisyPlane) {
   EXPECT_LT(syn::score(contour, result.relief_vertices, scan.random.scan).p95_to_truth, 1.5);
 }
 
+// Random scan 1078: a gear on a cylinder whose top drops inwards, a blended step 6 edges wide, h typed
+// x1.39. The contour stopped 1.3 edges up the slope with half the step only 1.5 edges inside it, short
+// of the offset that let the foot stage run, and the result was wrong and converged. The step rises
+// over 2 edges from a quarter to three quarters of its height (a sharp one within one): the foot
+// stage runs, and the contour settles within an edge of the foot.
+TEST(SegmentFoot, AWideRiseLetsTheFootStageRun) {
+  const RandomRun scan(1078);
+  ASSERT_EQ(scan.random.draw.axes["step"], "blended");
+  const Result result = scan.run(scan.options);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  EXPECT_GE(check_value(result, "rise_width") * result.parameters.step_height, 2 * scan.mesh.average_edge_length());
+  EXPECT_TRUE(has_note(result, "settled at the foot"));
+  scan.expect_accurate(result);
+  syn::Polyline contour;
+  contour.points = result.polyline;
+  contour.closed = true;
+  // 0.96 edges from the truth on average without the stage (the suite's area IoU below its floor).
+  EXPECT_LT(syn::score(contour, result.relief_vertices, scan.random.scan).mean_to_truth, 0.5);
+}
+
 // Random scan 1051: a C on a sphere, one edge per h. The coarse contour bridges the C's gap and
 // refinement rightly leaves the gap's background behind: the final region overlaps the coarse one
 // by under 60%. It kept the coarse region's relief, so it did not cross the relief: converged

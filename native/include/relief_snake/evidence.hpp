@@ -85,6 +85,10 @@ struct StepEvidence {
   double longest_far = 0;             ///< longest run of such profiles, as contour length
   int far_point = -1;                 ///< contour index in the middle of that run (-1: none)
   double foot_gap_median = 0, foot_gap_q75 = 0;  ///< of the on-step profiles' foot gaps (mesh units)
+  /// Median width of the on-step profiles' rise, from a quarter to three quarters of the step found
+  /// (in whole bins of one average edge; mesh units): about an edge on a sharp step, the slope's
+  /// half width on a blended one.
+  double rise_width_median = 0;
   double average_edge = 0;            ///< the mesh's, for the checks measured in edges
   double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
 };
