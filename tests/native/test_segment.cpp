@@ -436,11 +436,15 @@ struct RandomRun {
   Result run(const Options& o) const { return segment(mesh, random.picks.vertices, o); }
   /// Accurate as the random suite counts it: mean distances both ways within one average edge, IoU at
   /// least the one-edge floor.
-  void expect_accurate(const Result& r) const {
+  /// The result scored against the truth, as the random suite scores it.
+  syn::Score score(const Result& r) const {
     syn::Polyline contour;
     contour.points = r.polyline;
     contour.closed = r.closed;
-    const syn::Score s = syn::score(contour, r.relief_vertices, random.scan);
+    return syn::score(contour, r.relief_vertices, random.scan);
+  }
+  void expect_accurate(const Result& r) const {
+    const syn::Score s = score(r);
     EXPECT_GE(s.iou, syn::one_edge_floor(random.scan).vertices);
     EXPECT_LE(s.mean_to_truth, 1.0);
     EXPECT_LE(s.mean_from_truth, 1.0);
@@ -473,11 +477,8 @@ TEST(SegmentFoot, TheFootStageDoesNotOvershootOnANoisyPlane) {
   ASSERT_EQ(result.status, Status::Converged) << result.message;
   EXPECT_TRUE(has_note(result, "settled at the foot"));
   scan.expect_accurate(result);
-  syn::Polyline contour;
-  contour.points = result.polyline;
-  contour.closed = true;
   // The runs past the foot: 95% of the contour within 1.5 edges of the truth (it was 2.2).
-  EXPECT_LT(syn::score(contour, result.relief_vertices, scan.random.scan).p95_to_truth, 1.5);
+  EXPECT_LT(scan.score(result).p95_to_truth, 1.5);
 }
 
 // Random scan 1078: a gear on a cylinder whose top drops inwards, a blended step 6 edges wide, h typed
@@ -493,11 +494,8 @@ TEST(SegmentFoot, AWideRiseLetsTheFootStageRun) {
   EXPECT_GE(check_value(result, "rise_width") * result.parameters.step_height, 2 * scan.mesh.average_edge_length());
   EXPECT_TRUE(has_note(result, "settled at the foot"));
   scan.expect_accurate(result);
-  syn::Polyline contour;
-  contour.points = result.polyline;
-  contour.closed = true;
   // 0.96 edges from the truth on average without the stage (the suite's area IoU below its floor).
-  EXPECT_LT(syn::score(contour, result.relief_vertices, scan.random.scan).mean_to_truth, 0.5);
+  EXPECT_LT(scan.score(result).mean_to_truth, 0.5);
 }
 
 // Random scan 1051: a C on a sphere, one edge per h. The coarse contour bridges the C's gap and
