@@ -336,6 +336,11 @@ bool background_taken_in(const ContourEvidence& e, const SelfCheckOptions& optio
          deep_background_piece(e.background_depth, e.background_area, background_depth_limit(e, options));
 }
 
+bool strayed_from_coarse(double coarse_step_share, double coarse_iou, const SelfCheckOptions& options) {
+  return (coarse_step_share >= options.min_step_share && coarse_iou < options.min_coarse_iou) ||
+         (coarse_step_share >= options.strayed_min_step_share && coarse_iou < options.strayed_coarse_iou);
+}
+
 SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& options, const Vec3* far_position) {
   SelfCheck check;
   const StepEvidence& evidence = all.step;
@@ -375,9 +380,8 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
   // deflation carried the snake across the step. (A coarse contour still on the
   // background, from picks far out, may rightly be left behind.)
   // A refinement that let go of background only (a bridged concavity) is not one that crossed.
-  const bool coarse_left =
-      all.coarse_step_share >= options.min_step_share && all.coarse_iou < options.min_coarse_iou &&
-      !(all.coarse_relief_kept >= options.min_coarse_relief_kept);
+  const bool coarse_left = strayed_from_coarse(all.coarse_step_share, all.coarse_iou, options) &&
+                           !(all.coarse_relief_kept >= options.min_coarse_relief_kept);
   if (coarse_left)
     check.reasons.push_back("the refined region overlaps the coarse contour's by only " + percent(all.coarse_iou) +
                             (all.coarse_relief_kept >= 0
@@ -407,7 +411,9 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("the surface keeps rising for about " +
                             number(evidence.foot_gap_median / evidence.average_edge) +
                             " average edges outside the contour: it runs partway up the step (h may be too small)");
-  const double coarse_iou = all.coarse_step_share < options.min_step_share ? 1.0
+  const bool coarse_on_step = all.coarse_step_share >= options.min_step_share ||
+                              strayed_from_coarse(all.coarse_step_share, all.coarse_iou, options);
+  const double coarse_iou = !coarse_on_step ? 1.0
                             : all.coarse_relief_kept >= 0 ? std::max(all.coarse_iou, all.coarse_relief_kept)
                                                           : all.coarse_iou;
   check.holds = check.reasons.empty();

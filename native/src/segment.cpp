@@ -554,8 +554,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       a.evidence.abandoned_area_share = a.run.abandoned && a.run.abandoned_for_area ? a.run.abandoned_area_share : -1.0;
       a.evidence.abandoned_left_share = a.run.abandoned && !a.run.abandoned_for_area ? a.run.abandoned_left_share : -1.0;
       a.evidence.coarse_iou = region_iou(mesh, coarse_region, a.region);
-      if (options.coarse_relief_kept && a.evidence.coarse_iou < self_check.min_coarse_iou &&
-          coarse_step_share >= self_check.min_step_share)
+      if (options.coarse_relief_kept && strayed_from_coarse(coarse_step_share, a.evidence.coarse_iou, self_check))
         a.evidence.coarse_relief_kept = kept_of_coarse_relief(a.region);
       if (options.closed) {
         std::vector<Vec3> polyline;

@@ -154,7 +154,22 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   EXPECT_NE(c.reasons.front().find("keeps 50% of the relief"), std::string::npos) << c.reasons.front();
   e.coarse_relief_kept = -1;  // not measured: the overlap alone decides
   EXPECT_FALSE(judge(e, 1.0).holds);
+  // A coarse contour on a step along 3/4 of its length (under min_step_share): a region that left
+  // most of it (overlap under strayed_coarse_iou) fails; one that overlaps it by half does not.
+  e.coarse_step_share = 0.8;
+  EXPECT_TRUE(strayed_from_coarse(e.coarse_step_share, e.coarse_iou));
+  c = judge(e, 1.0);
+  ASSERT_EQ(c.reasons.size(), 1u);
+  EXPECT_NE(c.reasons.front().find("overlaps the coarse contour's by only 30%"), std::string::npos) << c.reasons.front();
+  e.coarse_relief_kept = 0.95;  // the relief kept exempts it as on the upper tier
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.coarse_relief_kept = -1;
+  e.coarse_iou = 0.5;
+  EXPECT_FALSE(strayed_from_coarse(e.coarse_step_share, e.coarse_iou));
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.coarse_iou = 0.3;
   e.coarse_step_share = 0.2;  // the coarse contour never reached the step: leaving it behind is fine
+  EXPECT_FALSE(strayed_from_coarse(e.coarse_step_share, e.coarse_iou));
   EXPECT_TRUE(judge(e, 1.0).holds);
   e.area_ratio = 2.0;
   EXPECT_FALSE(judge(e, 1.0).holds);
