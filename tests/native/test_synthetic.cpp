@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <random>
@@ -669,6 +670,33 @@ TEST(SyntheticRandom, TexturesStayWithinTheirAmplitudeOffTheRelief) {
       }
     }
   }
+}
+
+TEST(SyntheticRandom, BoundaryLiesOnTheTexturedBackground) {
+  // On a plane with striations, the surface off the relief is z = the texture; the true boundary (the
+  // foot of the step) lies on it, not on the smooth base under it, so a contour exactly at the foot
+  // scores 0 and the one-edge floor grows from where the scan's surface is.
+  ScanSpec spec = make_spec(Shape::Disk, Background::Plane, 40000);
+  spec.texture = Texture::Striations;
+  spec.texture_amplitude = 0.25;
+  spec.texture_period = 3;
+  spec.texture_angle = 0.4;
+  const Scan s = generate(spec);
+  ASSERT_EQ(s.boundary.size(), 1u);
+  const double A = spec.texture_amplitude * spec.h, P = spec.texture_period * spec.h;
+  double highest = 0, nearest_sum = 0;
+  for (const Vec3& p : s.boundary[0].points) {
+    const double texture = A * std::sin(2 * M_PI * (p.x() * std::cos(spec.texture_angle) + p.y() * std::sin(spec.texture_angle)) / P);
+    ASSERT_NEAR(p.z(), texture, 1e-9);
+    highest = std::max(highest, std::fabs(p.z()));
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t v = 0; v < s.n_vertices(); ++v)
+      if (!s.relief[v]) nearest = std::min(nearest, (s.vertex(v) - p).norm());
+    nearest_sum += nearest;
+  }
+  EXPECT_GT(highest, 0.9 * A);  // the boundary does go up and down with the texture
+  // The background's vertices lie within an edge of it (on the base it was up to A = 0.25 h away).
+  EXPECT_LT(nearest_sum / s.boundary[0].points.size(), s.average_edge);
 }
 
 TEST(SyntheticRandom, OneEdgeFloorMatchesAnOffsetRegion) {

@@ -163,7 +163,7 @@ struct Scan {
   std::vector<std::int64_t> F;  ///< #F by 3, counter-clockwise seen from the +normal side
   std::vector<double> UV;       ///< #V by 2: parameter coordinates of each vertex
   std::vector<std::uint8_t> relief;  ///< #V: 1 where sd(u, v) < 0
-  std::vector<Polyline> boundary;    ///< true boundary at the foot of the step (height 0), dense
+  std::vector<Polyline> boundary;    ///< true boundary at the foot of the step (on the background's texture, noise left out), dense
                                      ///< (spacing <= average_edge / 8); relief on the left
   double h = 1;
   double average_edge = 0;     ///< mean length of the unique 3D mesh edges
