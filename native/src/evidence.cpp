@@ -102,11 +102,13 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   };
 
   const double strip_half_width = std::max(0.5 * h, 1.5 * edge);
-  // Per measured profile: (distance inwards, height) of the inside vertices in a strip across
-  // the contour, for the offset to the step once the step height is known.
-  std::vector<std::vector<std::pair<double, double>>> strips;
-  // The same strips with the outside vertices too, for the width of the rise.
-  std::vector<std::vector<std::pair<double, double>>> whole_strips;
+  // Per measured profile: the vertices in a strip across the contour, for the offset to the step
+  // (inside ones) and the width of the rise (all) once the step height is known.
+  struct StripSample {
+    double across, height;  // distance inwards, height above the outside plane
+    bool inside;
+  };
+  std::vector<std::vector<StripSample>> strips;
 
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
   std::vector<double> heights;
@@ -191,16 +193,13 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       if (inward.dot(inside_mean) < 0) inward = -inward;
       heights.clear();
       strips.emplace_back();
-      whole_strips.emplace_back();
       for (const int v : ball) {
         const Vec3 d = mesh.position(v) - centre;
         const double across = d.dot(inward), along = d.dot(tangent);
         const double height = (mesh.position(v) - mean).dot(normal);
-        if (std::fabs(along) <= strip_half_width) whole_strips.back().push_back({across, height});
-        if (!region[v]) continue;
-        if (across >= front_from && across <= front_to && std::fabs(along) <= front_half_width)
+        if (std::fabs(along) <= strip_half_width) strips.back().push_back({across, height, region[v] != 0});
+        if (region[v] && across >= front_from && across <= front_to && std::fabs(along) <= front_half_width)
           heights.push_back(height);
-        if (std::fabs(along) <= strip_half_width) strips.back().push_back({across, height});
       }
       if (heights.size() >= 2) {
         profile.front_measured = true;
@@ -209,7 +208,6 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       profile.foot_gap = foot_gap(centre, inward, tangent, profile.rise);
     } else {
       strips.emplace_back();
-      whole_strips.emplace_back();
     }
     evidence.profiles.push_back(profile);
   }
@@ -253,8 +251,8 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     std::vector<double> offsets;
     for (std::size_t k = 0; k < evidence.profiles.size(); ++k) {
       double offset = radius;
-      for (const auto& [across, height] : strips[k])
-        if (height >= 0.5 * evidence.step_height) offset = std::min(offset, std::max(0.0, across));
+      for (const StripSample& x : strips[k])
+        if (x.inside && x.height >= 0.5 * evidence.step_height) offset = std::min(offset, std::max(0.0, x.across));
       evidence.profiles[k].offset = offset;
       offsets.push_back(offset);
     }
@@ -281,9 +279,9 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     for (std::size_t k = 0; k < evidence.profiles.size(); ++k) {
       if (!evidence.profiles[k].on_step) continue;
       for (auto& bin : bins) bin.clear();
-      for (const auto& [across, height] : whole_strips[k]) {
-        const long b = static_cast<long>(std::floor(across / edge)) + static_cast<long>(bins.size() / 2);
-        if (b >= 0 && b < static_cast<long>(bins.size())) bins[b].push_back(height);
+      for (const StripSample& x : strips[k]) {
+        const long b = static_cast<long>(std::floor(x.across / edge)) + static_cast<long>(bins.size() / 2);
+        if (b >= 0 && b < static_cast<long>(bins.size())) bins[b].push_back(x.height);
       }
       double quarter = -1, three_quarters = -1;
       for (std::size_t b = 0; b < bins.size(); ++b) {

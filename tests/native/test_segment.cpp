@@ -434,8 +434,6 @@ struct RandomRun {
     options.step_height = random.scan.h * random.draw.typed_factor;
   }
   Result run(const Options& o) const { return segment(mesh, random.picks.vertices, o); }
-  /// Accurate as the random suite counts it: mean distances both ways within one average edge, IoU at
-  /// least the one-edge floor.
   /// The result scored against the truth, as the random suite scores it.
   syn::Score score(const Result& r) const {
     syn::Polyline contour;
@@ -443,6 +441,8 @@ struct RandomRun {
     contour.closed = r.closed;
     return syn::score(contour, r.relief_vertices, random.scan);
   }
+  /// Accurate as the random suite counts it: mean distances both ways within one average edge, IoU at
+  /// least the one-edge floor.
   void expect_accurate(const Result& r) const {
     const syn::Score s = score(r);
     EXPECT_GE(s.iou, syn::one_edge_floor(random.scan).vertices);
