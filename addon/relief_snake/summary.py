@@ -5,6 +5,8 @@ Result dicts are relief_snake_core's (docs/result-format.md); keys this add-on d
 are treated as absent, so an older or newer engine still gets a summary.
 """
 
+import math
+
 __all__ = ["STATUS_WORDS", "result_summary", "status_warning", "phase_lines", "timing_line",
            "step_height_line", "PHASE_WORDS"]
 
@@ -67,13 +69,28 @@ def status_warning(result):
 
 
 def step_height_line(result, format_length=str):
-    """'Estimated step height: 0.81 m (confidence 0.9)' when the engine estimated h, else None.
+    """The step height in plain words, or None when there is nothing to say.
 
-    The result's step_height is {"used", "given", "estimate", "confidence"} (docs/result-format.md)."""
+    Estimated h: 'Estimated step height: 0.81 m (confidence 0.90)', or, when the step measured at
+    the outline's edge differs from the h the outline was made with, 'Estimated step height: 0.81 m
+    at the outline's edge, outlined with h = 0.70 m (confidence 0.90)'. Typed h: a line only when
+    the edge's step is off it by more than x1.33. The result's step_height is {"used", "given",
+    "estimate", "confidence", "measured"} (docs/result-format.md)."""
     sh = result.get("step_height")
-    if not isinstance(sh, dict) or sh.get("given") is not None or not sh.get("used"):
+    if not isinstance(sh, dict) or not sh.get("used"):
         return None
-    line = "Estimated step height: %s" % format_length(float(sh["used"]))
+    used, measured = float(sh["used"]), sh.get("measured")
+    measured = float(measured) if isinstance(measured, (int, float)) and measured > 0 else None
+    if sh.get("given") is not None:
+        if measured is None or 0.75 <= measured / used <= 1.33:
+            return None
+        return "The step at the outline's edge measures %s, against the h typed (%s)" % (
+            format_length(measured), format_length(used))
+    if measured is not None and abs(math.log(measured / used)) > math.log(1.05):
+        line = "Estimated step height: %s at the outline's edge, outlined with h = %s" % (
+            format_length(measured), format_length(used))
+    else:
+        line = "Estimated step height: %s" % format_length(used)
     if sh.get("confidence") is not None:
         line += " (confidence %.2f)" % float(sh["confidence"])
     return line

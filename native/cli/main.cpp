@@ -376,6 +376,16 @@ int run_segment(const std::vector<std::string>& args) {
                  rs::to_string(result.status), segment_seconds, result.polyline.size(), result.relief_vertices.size(),
                  a.out_path.empty() ? "" : "; wrote ", a.out_path.c_str());
   }
+  if (!a.quiet && result.step_height_measured > 0) {
+    // The step the scan shows at the result's edge, beside the h the snake ran with.
+    const double used = result.parameters.step_height, measured = result.step_height_measured;
+    if (!(a.options.step_height > 0))
+      std::fprintf(stderr, "relief-snake: step height estimated: %.4g at the contour's edge, segmented with h = %.4g "
+                   "(confidence %.2f)\n", measured, used, result.step_height_confidence);
+    else if (measured > 1.33 * used || measured < 0.75 * used)
+      std::fprintf(stderr, "relief-snake: the step at the contour's edge measures %.4g, against h = %.4g typed\n",
+                   measured, used);
+  }
   if (!a.quiet && !result.message.empty()) std::fprintf(stderr, "relief-snake: %s\n", result.message.c_str());
   // 3: a result was written, but the engine does not vouch for it (doubtful, iteration cap).
   return result.status == rs::Status::Converged ? 0 : 3;

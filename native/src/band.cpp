@@ -284,6 +284,7 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
     const StepEvidence& step = ring.evidence.step;
     const std::vector<std::pair<std::string, double>> named = {
         {"step_share", step.step_share},         {"step_height", step.step_height},
+        {"edge_step_height", step.edge_step_height},
         {"rise_median", step.rise_median},       {"step_spread", step.step_spread},
         {"foot_share", step.foot_share},         {"background_residual", step.background_residual},
         {"measured_share", step.measured_share()}, {"coarse_step_share", ring.evidence.coarse_step_share},
@@ -292,6 +293,10 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
   };
   add_checks("", best.first);
   add_checks("band_", best.second);
+  {
+    const double a = best.first.evidence.step.edge_step_height, b = best.second.evidence.step.edge_step_height;
+    result.step_height_measured = a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b);
+  }
   const double area = region_area(mesh, best.region);
   result.checks.push_back({"region_area", area});
   for (const std::string& r : best.first.check.reasons) result.reasons.push_back("first ring: " + r);

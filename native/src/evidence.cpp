@@ -81,6 +81,59 @@ double region_iou(const Mesh& mesh, const std::vector<char>& a, const std::vecto
   return either > 0 ? both / either : 1.0;
 }
 
+namespace {
+
+// One sample of the surface in a strip across the contour at a measured point.
+struct StripSample {
+  double across, height;  // distance inwards, height above the outside plane
+  bool inside;            // a vertex of the region
+};
+
+// The height where one profile's rise levels off (its knee; 0: none found). The strip's samples in
+// bins of `bin` across the contour (medians), walked inwards from the first bin at a quarter of
+// `step`: the walk stops at the first bin at or past half of it where the slope to the bin two
+// further in falls under max(knee_min_slope, knee_relative_slope x the steepest slope so far), and
+// reads the higher of that bin and the next. Past the knee the surface is the relief's top: a dome
+// keeps rising there, a rim's inner side falls away, so the rise over the whole ball (the profile's
+// rise_quantile) reads the step too high or too low.
+double knee_height(const std::vector<StripSample>& strip, double bin, double radius, double step,
+                   const EvidenceOptions& o) {
+  const long half = static_cast<long>(radius / bin) + 1, n = 2 * half + 1;
+  std::vector<std::vector<double>> bins(static_cast<std::size_t>(n));
+  for (const StripSample& x : strip) {
+    const long b = static_cast<long>(std::floor(x.across / bin)) + half;
+    if (b >= 0 && b < n) bins[b].push_back(x.height);
+  }
+  std::vector<double> median(static_cast<std::size_t>(n), 0.0);
+  for (long b = 0; b < n; ++b)
+    if (!bins[b].empty()) median[b] = quantile(bins[b], 0.5);
+  long quarter = -1, mid = -1;
+  for (long b = half - 1; b < n && mid < 0; ++b) {  // from one bin outside the contour inwards
+    if (bins[b].empty()) continue;
+    if (quarter < 0 && median[b] >= 0.25 * step) quarter = b;
+    if (median[b] >= 0.5 * step) mid = b;
+  }
+  if (quarter < 0 || mid < 0) return 0;
+  double steepest = 0;
+  for (long b = quarter; b < n; ++b) {
+    if (bins[b].empty()) continue;
+    long next = -1;  // two bins further in (three where one is empty)
+    for (long c = b + 2; c < n && c <= b + 3 && next < 0; ++c)
+      if (!bins[c].empty()) next = c;
+    if (next < 0) return median[b];  // the strip ends: the highest reached
+    const double slope = (median[next] - median[b]) / (static_cast<double>(next - b) * bin);
+    steepest = std::max(steepest, slope);
+    if (b >= mid && slope < std::max(o.knee_min_slope, o.knee_relative_slope * steepest)) {
+      for (long c = b + 1; c < next; ++c)
+        if (!bins[c].empty()) return std::max(median[b], median[c]);
+      return median[b];
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
 StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& contour,
                           const std::vector<char>& region, double h, const EvidenceOptions& options) {
   StepEvidence evidence;
@@ -103,11 +156,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
 
   const double strip_half_width = std::max(0.5 * h, 1.5 * edge);
   // Per measured profile: the vertices in a strip across the contour, for the offset to the step
-  // (inside ones) and the width of the rise (all) once the step height is known.
-  struct StripSample {
-    double across, height;  // distance inwards, height above the outside plane
-    bool inside;
-  };
+  // (inside ones), the width of the rise and its knee (all) once the step height is known.
   std::vector<std::vector<StripSample>> strips;
 
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
@@ -293,6 +342,15 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       if (quarter >= 0 && three_quarters >= quarter) widths.push_back((three_quarters - quarter) * edge);
     }
     evidence.rise_width_median = quantile(widths, 0.5);
+    // The step at the edge: per on-step profile, the height where the rise levels off.
+    std::vector<double> knees;
+    const double knee_bin = std::max(options.knee_bin * h, edge);
+    for (std::size_t k = 0; k < evidence.profiles.size(); ++k)
+      if (evidence.profiles[k].on_step) {
+        const double knee = knee_height(strips[k], knee_bin, radius, evidence.step_height, options);
+        if (knee > 0) knees.push_back(knee);
+      }
+    evidence.edge_step_height = quantile(knees, 0.5);
   }
   return evidence;
 }

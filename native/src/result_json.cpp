@@ -73,7 +73,8 @@ json to_json(const Result& result, const Options& options, const Mesh& mesh, con
   json step_height = {{"used", result.parameters.step_height},
                       {"given", h_given ? json(options.step_height) : json(nullptr)},
                       {"estimate", h_given ? json(nullptr) : json(result.step_height_estimate)},
-                      {"confidence", result.step_height_confidence}};
+                      {"confidence", result.step_height_confidence},
+                      {"measured", result.step_height_measured > 0 ? json(result.step_height_measured) : json(nullptr)}};
   return json{{"format", "relief-snake-result/1"},
               {"status", to_string(result.status)},
               {"message", result.message},

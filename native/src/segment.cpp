@@ -814,6 +814,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
     result.notes.push_back("W_int " + fmt(best.w_int) + " chosen: the self-check failed with smaller values");
   result.parameters = best.parameters;
   result.parameters.step_height = best.h;
+  result.step_height_measured = best.evidence.step.edge_step_height;
   result.planarity_vertices = cache_->planarity ? cache_->planarity->raw_count() : 0;
   if (!h_given) {
     // As sure as the step found along the contour is even; a refitted h rests on that alone.
@@ -843,6 +844,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   const StepEvidence& step = best.evidence.step;
   result.checks.insert(result.checks.begin(), {{"step_share", step.step_share},
                    {"step_height", step.step_height},
+                   {"edge_step_height", step.edge_step_height},
                    {"rise_median", step.rise_median},
                    {"step_spread", step.step_spread},
                    {"foot_share", step.foot_share},

@@ -58,6 +58,24 @@ class Summaries(unittest.TestCase):
                          "Estimated step height: 0.812 m (confidence 0.90)")
         self.assertIsNone(summary.step_height_line(RESULT))
 
+    def test_step_measured_at_the_edge(self):
+        fmt = lambda v: "%.2f m" % v
+        # Estimated: the edge's step is named when it differs from the h the outline was made with.
+        r = dict(RESULT, step_height={"used": 0.70, "given": None, "estimate": 0.6, "confidence": 0.9, "measured": 0.81})
+        self.assertEqual(summary.step_height_line(r, fmt),
+                         "Estimated step height: 0.81 m at the outline's edge, outlined with h = 0.70 m (confidence 0.90)")
+        r = dict(RESULT, step_height={"used": 0.80, "given": None, "estimate": 0.6, "confidence": 0.9, "measured": 0.81})
+        self.assertEqual(summary.step_height_line(r, fmt), "Estimated step height: 0.80 m (confidence 0.90)")
+        # Typed: a line only when the edge's step is far from it.
+        r = dict(RESULT, step_height={"used": 1.0, "given": 1.0, "estimate": None, "confidence": 1.0, "measured": 1.2})
+        self.assertIsNone(summary.step_height_line(r, fmt))
+        r = dict(RESULT, step_height={"used": 1.0, "given": 1.0, "estimate": None, "confidence": 1.0, "measured": 1.6})
+        self.assertEqual(summary.step_height_line(r, fmt),
+                         "The step at the outline's edge measures 1.60 m, against the h typed (1.00 m)")
+        # An engine without the measurement, or none taken.
+        r = dict(RESULT, step_height={"used": 1.0, "given": None, "estimate": 1.0, "confidence": 0.5, "measured": None})
+        self.assertEqual(summary.step_height_line(r, fmt), "Estimated step height: 1.00 m (confidence 0.50)")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -97,6 +97,42 @@ TEST(Evidence, AContourOnTheStepShowsTheTrueStepAllRound) {
   }
 }
 
+// The step at the edge (the knee of each profile) reads the height the relief stands at right behind
+// its edge, where the inside's heights over the whole ball (step_height) read a dome inside the edge
+// too high and a rim's inner fall too low. The domes here are the steepest the randomized suite draws
+// (1 h over 3 h). The contour runs at the foot, a quarter h outside the edge, as a settled snake does.
+TEST(Evidence, TheStepAtTheEdgeIgnoresADomeOrARimBehindIt) {
+  struct Case {
+    syn::Step step;
+    double dome;
+    bool drop;
+  };
+  for (const Case c : {Case{syn::Step::Sharp, 0, false}, Case{syn::Step::Blended, 0, false},
+                       Case{syn::Step::Sharp, 1.0, false}, Case{syn::Step::Blended, 1.0, false},
+                       Case{syn::Step::Sharp, 0, true}}) {
+    syn::ScanSpec spec;
+    spec.shape = syn::Shape::Disk;
+    spec.step = c.step;
+    spec.dome = c.dome;
+    spec.dome_width = 3;
+    spec.drop = c.drop;
+    spec.triangles = 60000;
+    const syn::Scan scan = syn::generate(spec);
+    const Mesh mesh = syn::to_mesh(scan);
+    for (const double typed : {0.6, 1.0, 1.6}) {
+      SCOPED_TRACE(std::string(c.step == syn::Step::Sharp ? "sharp" : "blended") + (c.dome > 0 ? ", dome" : "") +
+                   (c.drop ? ", rim" : "") + ", h typed x" + std::to_string(typed));
+      const StepEvidence e = evidence_at(scan, mesh, 0.25 * scan.h, typed * scan.h);
+      EXPECT_GT(e.edge_step_height, 0.9 * scan.h);
+      EXPECT_LT(e.edge_step_height, 1.3 * scan.h);
+      // Where the whole ball's rise is off by more than a tenth, the edge's is nearer the step.
+      if (std::fabs(std::log(e.step_height / scan.h)) > std::log(1.1)) {
+        EXPECT_LT(std::fabs(std::log(e.edge_step_height / scan.h)), std::fabs(std::log(e.step_height / scan.h)));
+      }
+    }
+  }
+}
+
 TEST(Evidence, AContourInsideTheReliefOrOnTheBackgroundShowsNoStep) {
   const syn::Scan scan = disk_scan(syn::Background::Cylinder, syn::Step::Sharp);
   const Mesh mesh = syn::to_mesh(scan);

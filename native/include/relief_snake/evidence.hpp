@@ -47,6 +47,16 @@ struct EvidenceOptions {
   double foot_gap_from = 1.0, foot_gap_from_edges = 3;
   double foot_gap_level = 0.05;  ///< the walk stops at a bin below this share of the rise (on the clean blended disk of
                                  ///< SegmentFootGap, 0.15 read 1 edge for a contour 3.3 edges up the slope)
+  /// The knee of each profile (StepEvidence::edge_step_height): bins of knee_bin h (at least one
+  /// average edge) across the contour; the rise levels off where the slope two bins on falls under
+  /// knee_min_slope and under knee_relative_slope x the steepest slope before. A step's own slope is
+  /// at least 1.5 (blended over at most one h); a dome's at most 0.5 (the randomized suite's steepest,
+  /// 1 h over 3 h), so a floor of 0.6 stops at the step's top, not partway up the dome (0.3 read such
+  /// a dome 1.36 to 1.9 h high: Evidence.TheStepAtTheEdgeIgnoresADomeOrARimBehindIt). On the suite's
+  /// runs the two floors differ on 3 of about 2,000 (bench/, docs/design.md).
+  double knee_bin = 0.1;
+  double knee_min_slope = 0.6;
+  double knee_relative_slope = 0.35;
 };
 
 /// One measured contour point.
@@ -89,6 +99,11 @@ struct StepEvidence {
   /// (in whole bins of one average edge; mesh units): about an edge on a sharp step, the slope's
   /// half width on a blended one.
   double rise_width_median = 0;
+  /// The step at the contour's edge: the median over the on-step profiles of the height where the
+  /// rise levels off (its knee; EvidenceOptions::knee_*). step_height reads the inside's heights
+  /// over the whole ball, which a dome inside the edge lifts and a rim's inner fall lowers; this is
+  /// the height the relief stands at right behind its edge. 0: no knee found.
+  double edge_step_height = 0;
   double average_edge = 0;            ///< the mesh's, for the checks measured in edges
   double measured_share() const { return attempted ? double(profiles.size()) / attempted : 0.0; }
 };

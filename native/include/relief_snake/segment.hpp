@@ -186,6 +186,10 @@ struct Result {
   /// the engine is of the h it used in the end (0..1; 1 when given).
   double step_height_estimate = 0;
   double step_height_confidence = 1;
+  /// The step at the result contour's edge (StepEvidence::edge_step_height; a band: both rings'
+  /// geometric mean), typed h or not: what the scan's step measures, where h is what the snake
+  /// was run with. 0: not measured.
+  double step_height_measured = 0;
   int attempts = 0;                      ///< refinement runs tried (W_int and h choices)
 
   /// Inner holes (holes.hpp): each hole's final snaxels and 3D polyline (the relief lies outside
