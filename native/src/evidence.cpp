@@ -89,6 +89,30 @@ struct StripSample {
   bool inside;            // a vertex of the region
 };
 
+// RMS residual of the least-squares quadric height field z = c0 + c1 x + c2 y + c3 x^2 + c4 x y + c5 y^2
+// over `vertices`, in the frame of their plane fit (z along its normal; x, y in units of `scale`
+// to keep the normal equations conditioned); the plane's own residual with fewer than 12 vertices.
+double quadric_residual(const Mesh& mesh, const std::vector<int>& vertices, const VertexPlaneFit& plane,
+                        double scale) {
+  if (vertices.size() < 12) return plane.residual();
+  const Vec3 ax = plane.axes.col(2), ay = plane.axes.col(1);
+  Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+  double zz = 0;
+  for (const int v : vertices) {
+    const Vec3 d = mesh.position(v) - plane.centroid;
+    const double x = d.dot(ax) / scale, y = d.dot(ay) / scale, z = d.dot(plane.normal);
+    Eigen::Matrix<double, 6, 1> row;
+    row << 1, x, y, x * x, x * y, y * y;
+    normal_matrix += row * row.transpose();
+    rhs += row * z;
+    zz += z * z;
+  }
+  const Eigen::Matrix<double, 6, 1> c = normal_matrix.ldlt().solve(rhs);
+  const double sse = zz - 2 * c.dot(rhs) + c.dot(normal_matrix * c);
+  return std::sqrt(std::max(0.0, sse) / static_cast<double>(vertices.size()));
+}
+
 // The height where one profile's rise levels off (its knee; 0: none found). The strip's samples in
 // bins of `bin` across the contour (medians), walked inwards from the first bin at a quarter of
 // `step`: the walk stops at the first bin at or past half of it where the slope to the bin two
@@ -162,6 +186,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   std::vector<int> mark(mesh.n_vertices(), -1), ball;
   std::vector<double> heights;
   std::vector<int> outside, near_outside, far_outside;
+  std::vector<double> quadric_residuals;
   const double gap_bin = std::max(edge, radius / 1024);  // one edge (at most 1024 bins across the ball)
   std::vector<std::vector<double>> gap_bins(static_cast<std::size_t>(radius / gap_bin) + 1);
   const double gap_from = std::max(options.foot_gap_from * h, options.foot_gap_from_edges * edge);
@@ -215,6 +240,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       continue;
     const Vec3 mean = plane.centroid, normal = plane.normal;
     const double residual = plane.residual();
+    quadric_residuals.push_back(std::min(residual, quadric_residual(mesh, outside, plane, h)));
 
     heights.clear();
     for (const int v : ball)
@@ -273,6 +299,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   evidence.step_share = double(step_rises.size()) / evidence.profiles.size();
   evidence.rise_median = quantile(rises, 0.5);
   evidence.background_residual = quantile(residuals, 0.5);
+  evidence.background_quadric_residual = quantile(quadric_residuals, 0.5);
   if (!step_rises.empty()) {
     evidence.step_height = quantile(step_rises, 0.5);
     if (evidence.step_height > 0)

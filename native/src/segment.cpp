@@ -154,14 +154,16 @@ struct Attempt {
 // average edges inside it (StepEvidence::offset_median) or, with h at least 3 edges, the step rises
 // over at least 2 edges from a quarter to three quarters of its height (StepEvidence::
 // rise_width_median: a sharp or one-triangle step rises within one; on a coarser mesh one-edge bins
-// cannot tell them apart), and the outside planes' residual is under 5% of h. There the
-// feature energy holds the snake part of the way up the slope, and the foot stage brings it down to
-// the foot; on sharp steps (already at the foot), textured or noisy backgrounds (where the foot test
-// fires on the texture) and coarse meshes it only moved right contours off (randomized suite,
-// docs/design.md).
+// cannot tell them apart), and the background outside is clean: the residual of local quadrics
+// under 5% of h (StepEvidence::background_quadric_residual; the planes' residual also counted a
+// sphere's or a cylinder's curvature as roughness). There the feature energy holds the snake part of
+// the way up the slope, and the foot stage brings it down to the foot; on sharp steps (already at
+// the foot), textured or noisy backgrounds (where the foot test fires on the texture) and coarse
+// meshes it only moved right contours off (randomized suite, docs/design.md).
 bool blended_and_clean(const StepEvidence& step, double h, double edge) {
   const bool wide_rise = step.rise_width_median >= 2 * edge && h >= 3 * edge;
-  return step.step_share > 0 && (step.offset_median >= 1.5 * edge || wide_rise) && step.background_residual <= 0.05 * h;
+  return step.step_share > 0 && (step.offset_median >= 1.5 * edge || wide_rise) &&
+         step.background_quadric_residual <= 0.05 * h;
 }
 
 // a is better evidence than b.
@@ -849,6 +851,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
                    {"step_spread", step.step_spread},
                    {"foot_share", step.foot_share},
                    {"background_residual", step.background_residual},
+                   {"background_quadric_residual", step.background_quadric_residual},
                    {"measured_share", step.measured_share()},
                    {"coarse_step_share", best.evidence.coarse_step_share},
                    {"coarse_iou", best.evidence.coarse_iou},

@@ -133,6 +133,35 @@ TEST(Evidence, TheStepAtTheEdgeIgnoresADomeOrARimBehindIt) {
   }
 }
 
+// The background's roughness apart from its curvature (background_quadric_residual, the blended foot
+// stage's gate): a small sphere's plane residual reads as texture would, its quadric residual does not;
+// on a striated plane both read the texture.
+TEST(Evidence, TheQuadricResidualSeesTextureNotCurvature) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.background = syn::Background::Sphere;
+  spec.radius = 15;
+  spec.width = 40, spec.height = 40;
+  spec.h = 1.0;
+  spec.triangles = 20000;
+  const syn::Scan sphere = syn::generate(spec);
+  const Mesh sphere_mesh = syn::to_mesh(sphere);
+  const StepEvidence curved = evidence_at(sphere, sphere_mesh, 0.25, sphere.h);
+  EXPECT_GT(curved.background_residual, 0.05 * sphere.h);  // the plane gate would hold the foot stage off
+  EXPECT_LT(curved.background_quadric_residual, 0.01 * sphere.h);
+
+  spec.background = syn::Background::Plane;
+  spec.texture = syn::Texture::Striations;
+  spec.texture_amplitude = 0.2;
+  spec.texture_period = 2;
+  const syn::Scan striated = syn::generate(spec);
+  const Mesh striated_mesh = syn::to_mesh(striated);
+  const StepEvidence textured = evidence_at(striated, striated_mesh, 0.25, striated.h);
+  EXPECT_GT(textured.background_quadric_residual, 0.05 * striated.h);
+  EXPECT_LE(textured.background_quadric_residual, textured.background_residual);
+}
+
 TEST(Evidence, AContourInsideTheReliefOrOnTheBackgroundShowsNoStep) {
   const syn::Scan scan = disk_scan(syn::Background::Cylinder, syn::Step::Sharp);
   const Mesh mesh = syn::to_mesh(scan);

@@ -88,6 +88,9 @@ struct StepEvidence {
   double rise_median = 0;             ///< median rise of all measured profiles
   double step_spread = 0;             ///< (q75 - q25) / median of the on-step rises: how even the step is
   double background_residual = 0;     ///< median RMS residual of the outside fits
+  /// Median RMS residual of quadric height fields over the same outside vertices: the background's
+  /// roughness (texture, noise) apart from its curvature, which a plane's residual counts too.
+  double background_quadric_residual = 0;
   double front_low_share = 0;         ///< share of the measured profiles whose front is at background height
   double longest_front_low = 0;       ///< longest run of consecutive such profiles, as contour length
   double offset_median = 0, offset_q75 = 0, offset_q90 = 0, offset_q95 = 0;  ///< of the profiles' offsets to half the step
