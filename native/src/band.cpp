@@ -17,6 +17,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// One step from the two rings' measurements of it: their geometric mean, or the one measured.
+double both_rings(double a, double b) { return a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b); }
+
 // One ring's snake, as the outer contour's attempts: schedule, region side, evidence, verdict.
 struct RingRun {
   ScheduleRun run;
@@ -124,8 +127,7 @@ struct BandAttempt {
   int holds() const { return between() ? int(first.check.holds) + int(second.check.holds) : 0; }
   double score() const { return first.check.score + second.check.score; }
   double step_found() const {
-    const double a = first.evidence.step.step_height, b = second.evidence.step.step_height;
-    return a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b);
+    return both_rings(first.evidence.step.step_height, second.evidence.step.step_height);
   }
 };
 
@@ -188,7 +190,7 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
         for (char& f : side_b) f = !f;
       }
       const double a = side_step(mesh, path_a, side_a).step_height, b = side_step(mesh, path_b, side_b).step_height;
-      const double found = a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b);
+      const double found = both_rings(a, b);
       if (!(found > 0)) return none;
       h = std::clamp(found, 0.5 * mesh.average_edge_length(), mesh.bbox_diagonal() / 4);
       none.h = h;
@@ -293,10 +295,8 @@ Result segment_band(const Mesh& mesh, const std::vector<int>& first_ring, const 
   };
   add_checks("", best.first);
   add_checks("band_", best.second);
-  {
-    const double a = best.first.evidence.step.edge_step_height, b = best.second.evidence.step.edge_step_height;
-    result.step_height_measured = a > 0 && b > 0 ? std::sqrt(a * b) : std::max(a, b);
-  }
+  result.step_height_measured =
+      both_rings(best.first.evidence.step.edge_step_height, best.second.evidence.step.edge_step_height);
   const double area = region_area(mesh, best.region);
   result.checks.push_back({"region_area", area});
   for (const std::string& r : best.first.check.reasons) result.reasons.push_back("first ring: " + r);

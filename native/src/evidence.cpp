@@ -113,6 +113,29 @@ double quadric_residual(const Mesh& mesh, const std::vector<int>& vertices, cons
   return std::sqrt(std::max(0.0, sse) / static_cast<double>(vertices.size()));
 }
 
+// Medians of a strip's heights in bins of `bin` across the contour: bin b holds the samples whose
+// distance inwards lies in [(b - offset) bin, (b - offset + 1) bin), offset = floor(radius / bin) + 1,
+// so one empty bin lies beyond the ball on each side. NaN: an empty bin.
+struct StripBins {
+  long offset = 0;
+  std::vector<double> median;
+};
+
+StripBins bin_strip(const std::vector<StripSample>& strip, double bin, double radius) {
+  StripBins out;
+  out.offset = static_cast<long>(radius / bin) + 1;
+  const long n = 2 * out.offset + 1;
+  std::vector<std::vector<double>> heights(static_cast<std::size_t>(n));
+  for (const StripSample& x : strip) {
+    const long b = static_cast<long>(std::floor(x.across / bin)) + out.offset;
+    if (b >= 0 && b < n) heights[b].push_back(x.height);
+  }
+  out.median.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  for (long b = 0; b < n; ++b)
+    if (!heights[b].empty()) out.median[b] = quantile(heights[b], 0.5);
+  return out;
+}
+
 // The height where one profile's rise levels off (its knee; 0: none found). The strip's samples in
 // bins of `bin` across the contour (medians), walked inwards from the first bin at a quarter of
 // `step`: the walk stops at the first bin at or past half of it where the slope to the bin two
@@ -120,36 +143,29 @@ double quadric_residual(const Mesh& mesh, const std::vector<int>& vertices, cons
 // reads the higher of that bin and the next. Past the knee the surface is the relief's top: a dome
 // keeps rising there, a rim's inner side falls away, so the rise over the whole ball (the profile's
 // rise_quantile) reads the step too high or too low.
-double knee_height(const std::vector<StripSample>& strip, double bin, double radius, double step,
-                   const EvidenceOptions& o) {
-  const long half = static_cast<long>(radius / bin) + 1, n = 2 * half + 1;
-  std::vector<std::vector<double>> bins(static_cast<std::size_t>(n));
-  for (const StripSample& x : strip) {
-    const long b = static_cast<long>(std::floor(x.across / bin)) + half;
-    if (b >= 0 && b < n) bins[b].push_back(x.height);
-  }
-  std::vector<double> median(static_cast<std::size_t>(n), 0.0);
-  for (long b = 0; b < n; ++b)
-    if (!bins[b].empty()) median[b] = quantile(bins[b], 0.5);
+double knee_height(const StripBins& strip, double bin, double step, const EvidenceOptions& o) {
+  const std::vector<double>& median = strip.median;
+  const long n = static_cast<long>(median.size());
+  auto empty = [&](long b) { return std::isnan(median[b]); };
   long quarter = -1, mid = -1;
-  for (long b = half - 1; b < n && mid < 0; ++b) {  // from one bin outside the contour inwards
-    if (bins[b].empty()) continue;
+  for (long b = strip.offset - 1; b < n && mid < 0; ++b) {  // from one bin outside the contour inwards
+    if (empty(b)) continue;
     if (quarter < 0 && median[b] >= 0.25 * step) quarter = b;
     if (median[b] >= 0.5 * step) mid = b;
   }
   if (quarter < 0 || mid < 0) return 0;
   double steepest = 0;
   for (long b = quarter; b < n; ++b) {
-    if (bins[b].empty()) continue;
+    if (empty(b)) continue;
     long next = -1;  // two bins further in (three where one is empty)
     for (long c = b + 2; c < n && c <= b + 3 && next < 0; ++c)
-      if (!bins[c].empty()) next = c;
+      if (!empty(c)) next = c;
     if (next < 0) return median[b];  // the strip ends: the highest reached
     const double slope = (median[next] - median[b]) / (static_cast<double>(next - b) * bin);
     steepest = std::max(steepest, slope);
     if (b >= mid && slope < std::max(o.knee_min_slope, o.knee_relative_slope * steepest)) {
       for (long c = b + 1; c < next; ++c)
-        if (!bins[c].empty()) return std::max(median[b], median[c]);
+        if (!empty(c)) return std::max(median[b], median[c]);
       return median[b];
     }
   }
@@ -348,35 +364,26 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
     evidence.foot_gap_median = quantile(gaps, 0.5);
     evidence.foot_gap_q75 = quantile(gaps, 0.75);
     evidence.longest_far = far_run.length * spacing;
-    // The width of the rise across each on-step profile: from the outermost one-edge bin whose median
-    // stands a quarter of the step high to the outermost at three quarters.
-    std::vector<double> widths;
-    std::vector<std::vector<double>> bins(2 * static_cast<std::size_t>(radius / edge) + 2);
+    // Per on-step profile, from the strip's heights in bins across the contour: the width of the rise,
+    // from the outermost one-edge bin whose median stands a quarter of the step high to the outermost
+    // at three quarters; and the height where the rise levels off (the step at the edge).
+    std::vector<double> widths, knees;
+    const double knee_bin = std::max(options.knee_bin * h, edge);
     for (std::size_t k = 0; k < evidence.profiles.size(); ++k) {
       if (!evidence.profiles[k].on_step) continue;
-      for (auto& bin : bins) bin.clear();
-      for (const StripSample& x : strips[k]) {
-        const long b = static_cast<long>(std::floor(x.across / edge)) + static_cast<long>(bins.size() / 2);
-        if (b >= 0 && b < static_cast<long>(bins.size())) bins[b].push_back(x.height);
+      const StripBins one_edge = bin_strip(strips[k], edge, radius);
+      long quarter = -1, three_quarters = -1;
+      for (long b = 0; b < static_cast<long>(one_edge.median.size()); ++b) {
+        const double median = one_edge.median[b];
+        if (std::isnan(median)) continue;
+        if (quarter < 0 && median >= 0.25 * evidence.step_height) quarter = b;
+        if (three_quarters < 0 && median >= 0.75 * evidence.step_height) three_quarters = b;
       }
-      double quarter = -1, three_quarters = -1;
-      for (std::size_t b = 0; b < bins.size(); ++b) {
-        if (bins[b].empty()) continue;
-        const double median = quantile(bins[b], 0.5);
-        if (quarter < 0 && median >= 0.25 * evidence.step_height) quarter = double(b);
-        if (three_quarters < 0 && median >= 0.75 * evidence.step_height) three_quarters = double(b);
-      }
-      if (quarter >= 0 && three_quarters >= quarter) widths.push_back((three_quarters - quarter) * edge);
+      if (quarter >= 0 && three_quarters >= quarter) widths.push_back(double(three_quarters - quarter) * edge);
+      const double knee = knee_height(bin_strip(strips[k], knee_bin, radius), knee_bin, evidence.step_height, options);
+      if (knee > 0) knees.push_back(knee);
     }
     evidence.rise_width_median = quantile(widths, 0.5);
-    // The step at the edge: per on-step profile, the height where the rise levels off.
-    std::vector<double> knees;
-    const double knee_bin = std::max(options.knee_bin * h, edge);
-    for (std::size_t k = 0; k < evidence.profiles.size(); ++k)
-      if (evidence.profiles[k].on_step) {
-        const double knee = knee_height(strips[k], knee_bin, radius, evidence.step_height, options);
-        if (knee > 0) knees.push_back(knee);
-      }
     evidence.edge_step_height = quantile(knees, 0.5);
   }
   return evidence;
