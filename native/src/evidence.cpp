@@ -63,13 +63,20 @@ double region_area(const Mesh& mesh, const std::vector<char>& region) {
 double kept_relief_share(const Mesh& mesh, const BackgroundResult& fill, const std::vector<char>& region,
                          double rise) {
   if (!fill.ok() || region.size() != static_cast<std::size_t>(mesh.n_vertices())) return -1;
-  double relief = 0, kept = 0;
-  for (const int v : fill.region_vertices)
-    if (fill.height[v] >= rise) {
-      relief += mesh.vertex_area(v);
-      if (region[v]) kept += mesh.vertex_area(v);
+  double relief = 0, kept = 0, volume = 0, kept_volume = 0;
+  for (const int v : fill.region_vertices) {
+    const double area = mesh.vertex_area(v), height = fill.height[v];
+    if (height > 0) {
+      volume += area * height;
+      if (region[v]) kept_volume += area * height;
     }
-  return relief > 0 ? kept / relief : -1.0;
+    if (height >= rise) {
+      relief += area;
+      if (region[v]) kept += area;
+    }
+  }
+  if (!(relief > 0)) return -1.0;
+  return std::min(kept / relief, kept_volume / volume);
 }
 
 double region_iou(const Mesh& mesh, const std::vector<char>& a, const std::vector<char>& b) {

@@ -311,6 +311,41 @@ TEST(Evidence, KeptReliefShareCountsReliefNotBackground) {
   EXPECT_EQ(kept_relief_share(mesh, fill, disk, 100 * scan.h), -1.0);
 }
 
+// A relief whose top drops to 0.3 h within 1.5 h of its edge (the randomized suite's "drop"): a region
+// that keeps only the rim, a ring 2 h wide, keeps nearly all of the area standing half a step high,
+// but little more than half of the relief's volume above the background, so the share it reports is
+// the volume's (under the check's 0.8); the whole disk keeps both.
+TEST(Evidence, KeptReliefShareCountsTheVolumeARingLeavesOut) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Sharp;
+  spec.drop = true;
+  spec.h = 1.0;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  const auto region_where = [&](auto inside) {
+    std::vector<char> region(mesh.n_vertices(), 0);
+    for (std::size_t i = 0; i < scan.n_vertices(); ++i) {
+      const int v = mesh.input_to_mesh(i);
+      if (v >= 0) region[v] = inside(std::hypot(scan.UV[2 * i], scan.UV[2 * i + 1])) ? 1 : 0;
+    }
+    return region;
+  };
+  const std::vector<char> disk = region_where([](double r) { return r < 12.5; });
+  const BackgroundResult fill = fill_background(mesh, disk, scan.h);
+  ASSERT_TRUE(fill.ok()) << fill.message;
+  const std::vector<char> rim = region_where([](double r) { return r > 10 && r < 12.5; });
+  double relief = 0, rim_relief = 0;  // the area standing half a step high, and the rim's part of it
+  for (const int v : fill.region_vertices)
+    if (fill.height[v] >= 0.5 * scan.h) relief += mesh.vertex_area(v), rim_relief += rim[v] ? mesh.vertex_area(v) : 0;
+  ASSERT_GT(rim_relief / relief, 0.9);  // by area alone the ring would pass min_coarse_relief_kept
+  const double kept = kept_relief_share(mesh, fill, rim, 0.5 * scan.h);
+  EXPECT_LT(kept, 0.6);
+  EXPECT_LT(kept, SelfCheckOptions().min_coarse_relief_kept);
+  EXPECT_GT(kept_relief_share(mesh, fill, disk, 0.5 * scan.h), 0.98);
+}
+
 // A blended step beside a flat band running off the mesh (an open contour's scan).
 static syn::Scan blended_open_scan() {
   syn::ScanSpec spec;

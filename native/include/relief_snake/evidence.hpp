@@ -169,7 +169,8 @@ struct ContourEvidence {
   double coarse_step_share = 0; ///< the coarse contour's share on a step
   double coarse_iou = 1;        ///< area IoU of the final region with the coarse contour's
   /// Where coarse_iou fails: the share of the coarse region's relief (its vertices standing half a step
-  /// above the background filled in from around it) the final region keeps; -1: not measured.
+  /// above the background filled in from around it, and its volume above it: kept_relief_share) the
+  /// final region keeps; -1: not measured.
   double coarse_relief_kept = -1;
   double area_ratio = 1;        ///< closed contours: the region's vector area against the contour's (1: they agree)
   double other_side_share = -1; ///< open contours with the side decided: the step share seen from the other side (-1: not measured)
@@ -228,9 +229,11 @@ struct FlagRun {
 };
 FlagRun longest_run(const std::vector<char>& flags, bool closed);
 
-/// The share (by area) of the relief in `fill`'s region, the vertices standing at least `rise` above
-/// the filled-in background (background.hpp), that `region` (#V flags) keeps; -1 when the fill failed
-/// or nothing stands that high.
+/// The share of the relief in `fill`'s region that `region` (#V flags) keeps: the smaller of the
+/// share by area of the vertices standing at least `rise` above the filled-in background
+/// (background.hpp) and the share of the volume above it. The volume's share sees a region that kept
+/// only a relief's rim where its top drops lower inside (a ring round a sunken middle keeps most of
+/// the area standing half a step high). -1 when the fill failed or nothing stands `rise` high.
 double kept_relief_share(const Mesh& mesh, const BackgroundResult& fill, const std::vector<char>& region,
                          double rise);
 
