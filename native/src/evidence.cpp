@@ -504,6 +504,10 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
       (evidence.step_height > options.max_step_ratio * h || evidence.step_height * options.max_step_ratio < h))
     check.reasons.push_back("the step along the contour is " + number(evidence.step_height) +
                             " high, far from the step height used (" + number(h) + ")");
+  if (evidence.edge_step_height > 0 && (evidence.edge_step_height > options.max_edge_step_ratio * h ||
+                                        evidence.edge_step_height * options.max_edge_step_ratio < h))
+    check.reasons.push_back("the step at the contour's edge is " + number(evidence.edge_step_height) +
+                            " high, far from the step height used (" + number(h) + ")");
   if (evidence.average_edge > 0 && evidence.foot_gap_median > options.max_foot_gap_edges * evidence.average_edge)
     check.reasons.push_back("the surface keeps rising for about " +
                             number(evidence.foot_gap_median / evidence.average_edge) +

@@ -184,6 +184,9 @@ const std::vector<Row>& rows() {
       boolean("confirmed_step", &Options::confirmed_step,
               "with the refit: a contour whose step (x1.5 to x2 off h) the refit measured again at that height, "
               "with weaker evidence there, is judged against x2 rather than the refit's x1.5 (not in the paper)"),
+      boolean("edge_step_refit", &Options::edge_step_refit,
+              "with the refit: a result that fails the self-check is segmented once more with h = the step "
+              "measured at its edge, where that disagrees with h (not in the paper)"),
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),

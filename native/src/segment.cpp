@@ -445,8 +445,11 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   // The verdicts with the refit-free step ratio, for a step the refit confirmed (judge_with_confirmed_step).
   SelfCheckOptions step_confirmed = self_check;
   step_confirmed.max_step_ratio = std::max(self_check.max_step_ratio, SelfCheckOptions().max_step_ratio);
+  // The step at the edge confirms h as far off as the step found may be.
+  step_confirmed.max_edge_step_ratio = std::max(self_check.max_edge_step_ratio, step_confirmed.max_step_ratio);
   SelfCheckOptions step_confirmed_contour_wise = contour_wise;
   step_confirmed_contour_wise.max_step_ratio = step_confirmed.max_step_ratio;
+  step_confirmed_contour_wise.max_edge_step_ratio = step_confirmed.max_edge_step_ratio;
   EvidenceOptions evidence_options;
   evidence_options.closed = options.closed;
 
@@ -722,6 +725,19 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       }
       notes->push_back(refitted);
       kept = std::move(next);
+    }
+    // Still failing: the step at the contour's edge (the knee), where it disagrees with h.
+    if (options.refit_step_height && options.edge_step_refit && !cancelled && kept.usable() && !kept.check.holds) {
+      const double edge_step = kept.evidence.step.edge_step_height;
+      if (refit_wanted(edge_step, kept.h, tried, options, largest_h)) {
+        tried.push_back(edge_step);
+        Attempt next = attempt_at(edge_step);
+        if (!cancelled && better(next, kept)) {
+          notes->push_back("the step at the contour's edge measured " + fmt(edge_step) + " against h = " +
+                           fmt(kept.h) + "; segmented again with h = " + fmt(edge_step));
+          kept = std::move(next);
+        }
+      }
     }
     return kept;
   };

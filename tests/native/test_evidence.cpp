@@ -278,6 +278,19 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   EXPECT_TRUE(judge(e, 1.0).holds);
   e.covered_share = -1;
   EXPECT_TRUE(judge(e, 1.0).holds);
+  // The step at the contour's edge (the knee) against h, both ways, judged only when measured (> 0):
+  // the whole-ball step (1.0 here) agrees with h.
+  const double limit = SelfCheckOptions().max_edge_step_ratio;
+  for (const double knee : {0.95 / limit, 1.05 * limit}) {
+    e.step.edge_step_height = knee;
+    c = judge(e, 1.0);
+    ASSERT_EQ(c.reasons.size(), 1u) << knee;
+    EXPECT_NE(c.reasons.front().find("the step at the contour's edge is"), std::string::npos);
+  }
+  for (const double knee : {1.05 / limit, 0.95 * limit, 0.0}) {
+    e.step.edge_step_height = knee;
+    EXPECT_TRUE(judge(e, 1.0).holds) << knee;
+  }
 }
 
 // The relief a coarse region encloses (background.hpp's fill from around it): a region that

@@ -532,6 +532,24 @@ TEST(SegmentRefit, AStepMeasuredAgainAtItsOwnHeightKeepsTheContour) {
   scan.expect_doubtful_with([](Options& o) { o.confirmed_step = false; }, "far from the step height used");
 }
 
+// Random scan 4185: a sharp rounded box under a dome on a sphere with striations, h typed x2.0. The
+// step found over the whole ball (x0.79 of h) reads the dome behind the edge and stays within the
+// refit's x1.3, and the contour at that h was a near miss called converged (1.14 edges from the
+// truth). The step at its edge reads x0.56 of h: the self-check fails on it, and the result segmented
+// again with h = that step is right and converged (with edge_step_refit=0 it stays doubtful).
+TEST(SegmentRefit, TheStepAtTheEdgeRefitsAnHTheDomeHid) {
+  const RandomRun scan(4185);
+  ASSERT_EQ(scan.random.draw.axes["detail"], "dome");
+  ASSERT_GT(scan.random.draw.typed_factor, 1.9);
+  EXPECT_TRUE(Options().edge_step_refit);
+  const Result result = scan.run(scan.options);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  EXPECT_TRUE(has_note(result, "the step at the contour's edge measured"));
+  EXPECT_LT(result.parameters.step_height / scan.random.scan.h, 1.33);
+  scan.expect_accurate(result);
+  scan.expect_doubtful_with([](Options& o) { o.edge_step_refit = false; }, "the step at the contour's edge is");
+}
+
 // An open contour's relief side decided from the surface can be wrong (the strips compared do not
 // say which side rises). Random scan 12, a blended band on a wavy background picked 2.4 h from it:
 // the surface decides left, where the snake finds no step and the self-check fails; the engine then
