@@ -15,6 +15,8 @@ namespace relief_snake {
 namespace synthetic {
 namespace {
 
+using Vec2 = Eigen::Vector2d;
+
 std::uint64_t mix(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -59,6 +61,36 @@ double nominal_edge_for(double triangles) {
   const double cv = std::max(2.0, std::round(0.5 * triangles / cu));
   const double su = kWidth / cu, sv = kHeight / cv;
   return (su + sv + std::hypot(su, sv)) / 3;
+}
+
+bool point_in_polygon(const std::vector<Vec2>& poly, const Vec2& q) {
+  bool in = false;
+  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const Vec2& a = poly[i];
+    const Vec2& b = poly[j];
+    if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x())
+      in = !in;
+  }
+  return in;
+}
+
+bool segments_cross(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  auto side = [](const Vec2& p, const Vec2& q, const Vec2& r) {
+    return (q.x() - p.x()) * (r.y() - p.y()) - (q.y() - p.y()) * (r.x() - p.x());
+  };
+  const double d1 = side(c, d, a), d2 = side(c, d, b), d3 = side(a, b, c), d4 = side(a, b, d);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
+}
+
+/// A closed polygon two of whose non-adjacent sides cross.
+bool polygon_crosses_itself(const std::vector<Vec2>& poly) {
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;
+      if (segments_cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n])) return true;
+    }
+  return false;
 }
 
 }  // namespace
@@ -318,11 +350,40 @@ RandomScan generate_random(std::uint64_t seed) {
         if (picks.closed && kept.size() > 1 && kept.front() == kept.back()) kept.pop_back();
         picks.vertices = kept;
       }
+      // A vertex picked twice (two picks snapped or moved onto the same one): kept once, where first.
+      {
+        std::vector<std::int64_t> distinct;
+        for (std::int64_t p : picks.vertices)
+          if (std::find(distinct.begin(), distinct.end(), p) == distinct.end()) distinct.push_back(p);
+        picks.vertices = distinct;
+      }
       bool valid = picks.vertices.size() >= (picks.closed ? 3u : 2u);
       for (std::int64_t p : picks.vertices) valid = valid && p >= 0;
       if (!valid) {
         last_error = "a pick did not land on a vertex";
         continue;
+      }
+      // Picks a user would make round a closed relief: a pick polygon (in the parameter plane) that does
+      // not cross itself and holds the whole relief. (A zigzag on a coarse mesh could cross itself, and a
+      // near ring round a C near the domain's edge could be the one inside its hole; the engine rightly
+      // refuses such picks, which measures nothing about the segmentation.)
+      if (picks.closed) {
+        std::vector<Vec2> poly;
+        for (std::int64_t p : picks.vertices) poly.emplace_back(scan.UV[2 * p], scan.UV[2 * p + 1]);
+        if (polygon_crosses_itself(poly)) {
+          last_error = "the pick polygon crosses itself";
+          continue;
+        }
+        std::size_t relief = 0, inside = 0;
+        for (std::size_t k = 0; k < scan.relief.size(); ++k) {
+          if (!scan.relief[k]) continue;
+          ++relief;
+          inside += point_in_polygon(poly, Vec2(scan.UV[2 * k], scan.UV[2 * k + 1])) ? 1 : 0;
+        }
+        if (inside < relief) {
+          last_error = "the picks do not go round the relief";
+          continue;
+        }
       }
       RandomScan out;
       out.draw = std::move(draw);
