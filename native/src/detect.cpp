@@ -91,16 +91,6 @@ std::vector<char> opening(const Mesh& mesh, const std::vector<int>& vertices, in
   return cur;
 }
 
-/// The vertices within `distance` (along edges) of `seeds`, never entering `blocked` vertices
-/// nor leaving the seeds' mesh component.
-std::vector<char> grow(const Mesh& mesh, const std::vector<int>& seeds, double distance,
-                       const std::function<bool(int)>& blocked) {
-  const std::vector<double> dist = edge_distances(mesh, seeds, distance, [&](int v) { return !blocked(v); });
-  std::vector<char> out(mesh.n_vertices(), 0);
-  for (int v = 0; v < mesh.n_vertices(); ++v) out[v] = dist[v] <= distance;
-  return out;
-}
-
 /// Picks along a loop at about `spacing` apart (at least 6 when the loop allows).
 std::vector<int> picks_along(const Mesh& mesh, const std::vector<int>& loop, double spacing) {
   if (loop.size() < 3) return {};
@@ -301,7 +291,7 @@ DetectResult detect(Segmenter& segmenter, const Mesh& mesh, const std::vector<st
                                                       : std::clamp(cand.height, 0.5 * edge, mesh.bbox_diagonal() / 4);
     const int self = static_cast<int>(c);
     const std::vector<char> grown =
-        grow(mesh, raw[c].vertices, std::max(options.outline_offset * h, 3 * edge),
+        grown_vertices(mesh, raw[c].vertices, std::max(options.outline_offset * h, 3 * edge),
              [&](int w) { return label[w] >= 0 && label[w] != self; });
     const std::vector<int> loop = region_outer_loop(mesh, grown);
     for (const int v : loop) cand.outline.push_back(mesh.to_file(mesh.position(v)));

@@ -470,6 +470,10 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
                             (all.covered_share < 0.005 ? std::string("under 1%") : percent(all.covered_share)) +
                             " of the surface the picks enclose that stands half a step above the background: the "
                             "snake may have settled on detail or texture inside the relief");
+  if (all.beyond_mask_share > options.max_beyond_mask_share)
+    check.reasons.push_back(percent(all.beyond_mask_share) +
+                            " of the region lies away from anything standing half a step above the background: it "
+                            "leaked past the contour or takes in background");
   if (evidence.step_share >= options.min_step_share && evidence.foot_share < options.min_foot_share)
     check.reasons.push_back("only " + percent(evidence.foot_share) +
                             " of the contour sits at the foot of the step; the rest runs partway up it");

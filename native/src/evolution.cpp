@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -161,7 +162,16 @@ int greedy_iteration(Snake& snake, FeatureEnergy& feature, const PhaseSettings& 
       double e_in = snaxel_energy(snake, p.i, p.candidate[1], f[1], phase);
       if (phase.w_d != 0)
         e_in += phase.w_d * deflation_energy(phase.alpha, phase.beta, phase.tau, p.li, phase.gamma_sigma2);
-      const double e_out = snaxel_energy(snake, p.i, p.candidate[2], f[2], phase);
+      double e_out = snaxel_energy(snake, p.i, p.candidate[2], f[2], phase);
+      if (phase.barrier) {
+        // A move onto the relief (above the barrier, and higher than the snaxel stands) is not one.
+        const auto height = [&](int v) { return (*phase.barrier)[v]; };
+        const double here = interpolate(mesh, p.candidate[0], height);
+        const double limit = std::max(here, phase.barrier_level);
+        constexpr double kForbidden = std::numeric_limits<double>::infinity();
+        if (interpolate(mesh, p.candidate[1], height) > limit) e_in = kForbidden;
+        if (interpolate(mesh, p.candidate[2], height) > limit) e_out = kForbidden;
+      }
       if (e_in < e_stay && e_in <= e_out) p.decision = 1;
       else if (e_out < e_stay && e_out < e_in) p.decision = 2;
     };

@@ -190,6 +190,9 @@ const std::vector<Row>& rows() {
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),
+      boolean("height_outline", &Options::height_outline,
+              "closed contours: when no refinement passes the self-check, refine once more from just outside "
+              "what stands half a step above the background filled in under the region (not in the paper)"),
       boolean("repair_background", &Options::repair_background,
               "closed contours: cut out a piece of background the region took in (a bridged concavity, a lobe) "
               "and refine again from the rest (not in the paper)"),

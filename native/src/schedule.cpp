@@ -145,6 +145,7 @@ ScheduleRun EvolutionSchedule::refine_snake(const Snake& start, bool all_levels,
   refine.w_d = param.w_d;
   refine.gamma_sigma2 = 0;
   refine = at_spacing(refine, param.refine_spacing);
+  if (!barrier_.empty()) refine.barrier = &barrier_, refine.barrier_level = barrier_level_;
 
   const double coarse_area = stop.min_area_share > 0 && options_.closed ? vector_area(start.polyline()).norm() : 0.0;
   const auto area_share = [coarse_area](const Snake& s) { return vector_area(s.polyline()).norm() / coarse_area; };

@@ -20,6 +20,8 @@
 #include "relief_snake/initial_contour.hpp"
 #include "relief_snake/planarity.hpp"
 #include "relief_snake/region.hpp"
+#include "relief_snake/mesh_graph.hpp"
+#include "relief_snake/relief_mask.hpp"
 #include "relief_snake/schedule.hpp"
 #include "relief_snake/snake.hpp"
 #include "relief_snake/step_height.hpp"
@@ -474,7 +476,9 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       options.w_int > 0 ? std::vector<double>{options.w_int} : std::vector<double>{0.25, 0.5, 1.0};
   bool cancelled = false;
   std::string collapse_phase;
-  auto attempt_at = [&](double h_try) {
+  // outline_from: instead of the refinements from the coarse snake, refine from just outside what the
+  // heights call relief under that attempt's region and the coarse one (relief_mask.hpp).
+  auto attempt_at = [&](double h_try, const Attempt* outline_from = nullptr) {
     Attempt best;
     best.h = h_try;
     const auto t_pre = Clock::now();
@@ -513,6 +517,8 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       return kept_relief_share(mesh, *coarse_fill, region, 0.5 * judged_step(h_try, coarse_step.step_height));
     };
     // The foot stage and the self-check of one refined run (a.run).
+    // Outline attempts (outline_from): how far the heights' relief reaches, grown past the start.
+    std::vector<char> mask_reach;
     auto settle_and_judge = [&](Attempt& a, BackgroundInside* inside_out) {
       // gated (foot_snap_blended): left alone unless most snaxels have a clean background outside.
       auto settle_at_the_foot = [&](bool gated) {
@@ -555,6 +561,12 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
         region_and_step();
       }
       a.evidence.covered_share = covered_share(mesh, enclosure, a.region, h_try, a.evidence.step.step_height);
+      if (!mask_reach.empty()) {
+        double beyond = 0, all = 0;
+        for (int v = 0; v < mesh.n_vertices(); ++v)
+          if (a.region[v]) all += mesh.vertex_area(v), beyond += mask_reach[v] ? 0.0 : mesh.vertex_area(v);
+        a.evidence.beyond_mask_share = all > 0 ? beyond / all : 0.0;
+      }
       a.evidence.coarse_step_share = coarse_step_share;
       a.evidence.abandoned_area_share = a.run.abandoned && a.run.abandoned_for_area ? a.run.abandoned_area_share : -1.0;
       a.evidence.abandoned_left_share = a.run.abandoned && !a.run.abandoned_for_area ? a.run.abandoned_left_share : -1.0;
@@ -645,7 +657,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       }
       unjudged.clear();
     };
-    for (const double w : w_steps) {
+    for (const double w : outline_from ? std::vector<double>{} : w_steps) {
       Attempt a;
       a.h = h_try;
       a.w_int = w;
@@ -687,6 +699,52 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       first = false;
     }
     judge_unjudged();
+    if (outline_from && !cancelled) {
+      // Closed: the coarse region with the refined one (the coarse contour bridges what refinement may
+      // have cut off). Open: the refined one alone, since an open coarse region is the whole side
+      // beyond the coarse contour, background up to the relief included.
+      std::vector<char> seed = coarse_region;
+      if (outline_from->usable()) {
+        if (!options.closed) seed = outline_from->region;
+        for (std::size_t v = 0; v < seed.size(); ++v) seed[v] = seed[v] || outline_from->region[v];
+      }
+      const double found = coarse_step.step_height;
+      const double step = found > 0 ? std::clamp(found, 0.5 * h_try, 2 * h_try) : h_try;
+      ReliefMaskOptions mask_options;
+      if (!options.closed) mask_options.min_share = 0;
+      const ReliefMask mask = relief_mask(mesh, seed, h_try, step, mask_options);
+      background_seconds += mask.seconds;
+      std::vector<int> loop = mask.ok ? start_outline(mesh, mask.start_region, options.closed) : std::vector<int>{};
+      if (!loop.empty()) {
+        if (!inside_left) std::reverse(loop.begin(), loop.end());
+        std::vector<SurfacePoint> outline;
+        outline.reserve(loop.size());
+        for (const int v : loop) outline.push_back(vertex_point(mesh, v));
+        schedule.set_barrier(mask.height, mask.level);
+        mask_reach = grown_region(mesh, mask.start_region, std::max(h_try, 3 * mesh.average_edge_length()),
+                                  tangential_length(mesh, mask.base_normals));
+        for (const double w : w_steps) {
+          Attempt a;
+          a.h = h_try;
+          a.w_int = w;
+          a.run = schedule.refine_from(outline, w, progress);
+          a.parameters = schedule.parameters(w);
+          ++result.attempts;
+          if (a.run.cancelled) {
+            cancelled = true;
+            return best;
+          }
+          if (!a.usable()) continue;
+          settle_and_judge(a, nullptr);
+          a.notes.insert(a.notes.begin(), "refined again from just outside what stands " + fmt(mask.level) +
+                                              " above the background filled in under the region");
+          const bool holds = a.check.holds;
+          if (first || better(a, best)) best = std::move(a);
+          first = false;
+          if (holds) break;
+        }
+      }
+    }
     return best;
   };
 
@@ -795,6 +853,34 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       }
       if (best.usable() && best.check.holds) break;
     }
+  }
+  // Still failing at every h tried: the snake refined from just outside what the heights call relief
+  // (relief_mask.hpp), at the kept attempt's h.
+  // Not for a side the engine decided whose result looks like the wrong side: the other side is
+  // segmented then (segment_deciding_side), and an outline on the background gave a failing result
+  // that no longer looked wrong-sided (random scan 12), so the right side was never tried.
+  const bool wrong_side_suspect =
+      side_decided && best.usable() &&
+      looks_like_the_wrong_side(best.evidence.step.step_share, best.evidence.step.measured_share(),
+                                best.evidence.other_side_share);
+  if (options.height_outline && !cancelled && best.usable() && !best.check.holds && !wrong_side_suspect) {
+    // At the step measured at the kept contour's edge where that is higher than h (up to x2): an h too
+    // small holds the snake partway up a blended step, and the outline starts outside its foot.
+    const double knee = best.evidence.step.edge_step_height;
+    const double h_outline = std::clamp(knee, best.h, 2 * best.h);
+    Attempt next = attempt_at(h_outline, &best);
+    // With its own refit: the start does not depend on h, the step found along it may.
+    std::vector<double> outline_tried = {h_outline};
+    for (int refit = 0; refit < 2 && options.refit_step_height && !cancelled && next.usable() && !next.check.holds;
+         ++refit) {
+      const double found = next.evidence.step.step_height;
+      if (!refit_wanted(found, next.h, outline_tried, options, largest_h)) break;
+      outline_tried.push_back(found);
+      Attempt again = attempt_at(found, &best);
+      if (cancelled || !better(again, next)) break;
+      next = std::move(again);
+    }
+    if (!cancelled && next.usable() && better(next, best)) best = std::move(next);
   }
   if (!h_given && !(h > 0))
     throw Error("could not estimate the step height: nothing rises above the background inside the picked "

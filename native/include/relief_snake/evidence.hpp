@@ -170,6 +170,8 @@ struct SelfCheckOptions {
   /// slope). Accuracy is judged to one average edge; the gap is measured in whole bins of one edge and
   /// falls short of the slope left outside.
   double max_foot_gap_edges = 1.5;
+  /// ContourEvidence::beyond_mask_share allowed.
+  double max_beyond_mask_share = 0.05;
 };
 
 /// Everything the self-check looks at for one contour.
@@ -193,6 +195,10 @@ struct ContourEvidence {
   /// Closed contours: the region's area against the area the picks enclose standing half a step (the
   /// lower of h and the step found) above the background along them (enclosure.hpp); -1: not measured.
   double covered_share = -1;
+  /// A snake refined from the heights' outline (relief_mask.hpp): the share of the region's area
+  /// farther from what stands half a step above the background than the start was (-1: not measured).
+  /// A region that leaked past its contour (along an open contour's mesh boundary) shows here.
+  double beyond_mask_share = -1;
   /// The background inside the region (background_inside.hpp), in h: the deepest low piece's
   /// depth and area, and the floor under the depth threshold (two average edges, in h).
   bool background_measured = false;

@@ -3,6 +3,7 @@
 // lowest-energy of {stay, inside candidate, outside candidate}; a phase repeats
 // iterations with the housekeeping until nothing moves or the cap is hit.
 #include <functional>
+#include <vector>
 
 #include "relief_snake/energy.hpp"
 #include "relief_snake/segment.hpp"
@@ -23,6 +24,11 @@ struct PhaseSettings {
   int max_iterations = 3000;
   bool remove_loops = true;   ///< cut off self-intersection loops (not in the paper)
   int min_snaxels = 4;        ///< fewer means the snake collapsed
+  /// A height per mesh vertex (#V; e.g. above the background model, relief_mask.hpp) that no move may
+  /// rise above barrier_level to, unless it ends lower than where the snaxel is: deflation cannot
+  /// carry a snaxel onto the relief (not in the paper). Null: no barrier.
+  const std::vector<double>* barrier = nullptr;
+  double barrier_level = 0;
   /// Asked every lock_interval iterations: true abandons the phase (PhaseOutcome::abandoned), e.g.
   /// a refinement that is carrying the snake across the relief. Empty: never.
   std::function<bool(const Snake&)> abandon;

@@ -70,6 +70,12 @@ class EvolutionSchedule {
   /// near the step: only the finest spacing runs). Runs the coarse phase first if needed (its
   /// phase is reported like refine()'s).
   ScheduleRun refine_from(const std::vector<SurfacePoint>& start, double w_int, const ProgressCallback& progress);
+  /// Refinements and stabilisations from now on keep every snaxel from moving onto a point that
+  /// stands above `level` in `height` (#V; PhaseSettings::barrier). Empty height: none.
+  void set_barrier(std::vector<double> height, double level) {
+    barrier_ = std::move(height);
+    barrier_level_ = level;
+  }
 
  private:
   const Mesh& mesh_;
@@ -82,6 +88,8 @@ class EvolutionSchedule {
   bool coarse_done_ = false;
   ScheduleRun coarse_run_;
   std::unique_ptr<Snake> coarse_snake_;  // as the coarse phase left it
+  std::vector<double> barrier_;          // set_barrier()
+  double barrier_level_ = 0;
   ScheduleRun refine_snake(const Snake& start, bool all_levels, double w_int, const ProgressCallback& progress,
                            const RefineStop& stop = {});
 };

@@ -115,6 +115,11 @@ struct Options {
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
   bool repair_background = true;
+  /// Closed contours whose refinements all fail the self-check: the relief as the heights see it
+  /// (relief_mask.hpp: what stands half a step above the background filled in under the coarse and
+  /// refined regions), and the snake refined again from just outside it at each W_int, keeping the
+  /// better evidence (not in the paper).
+  bool height_outline = true;
   /// New snaxels (splits, merges, the refinement's subdivision) at the surface point nearest the
   /// chord between their neighbours, instead of the end of a straight surface walk along it.
   bool nearest_resampling = true;
