@@ -478,6 +478,12 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   std::string collapse_phase;
   // outline_from: instead of the refinements from the coarse snake, refine from just outside what the
   // heights call relief under that attempt's region and the coarse one (relief_mask.hpp).
+  // A loop of vertices (region_outer_loop, start_outline: relief on the left) as a snake's start,
+  // oriented to the relief side.
+  auto snake_start_along = [&](std::vector<int> loop) {
+    if (!inside_left) std::reverse(loop.begin(), loop.end());
+    return vertex_points(mesh, loop);
+  };
   auto attempt_at = [&](double h_try, const Attempt* outline_from = nullptr) {
     Attempt best;
     best.h = h_try;
@@ -609,13 +615,9 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       const double limit = background_depth_limit(a.evidence, self_check) * h_try;
       std::vector<int> loop = region_outer_loop(mesh, inside.region_without(a.region, limit));
       if (loop.size() < 8) return r;
-      if (!inside_left) std::reverse(loop.begin(), loop.end());
-      std::vector<SurfacePoint> outline;
-      outline.reserve(loop.size());
-      for (const int v : loop) outline.push_back(vertex_point(mesh, v));
       r.h = h_try;
       r.w_int = w;
-      r.run = schedule.refine_from(outline, w, progress);
+      r.run = schedule.refine_from(snake_start_along(std::move(loop)), w, progress);
       r.parameters = a.parameters;
       ++result.attempts;
       if (r.run.cancelled || r.run.collapsed) return r;
@@ -716,10 +718,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       background_seconds += mask.seconds;
       std::vector<int> loop = mask.ok ? start_outline(mesh, mask.start_region, options.closed) : std::vector<int>{};
       if (!loop.empty()) {
-        if (!inside_left) std::reverse(loop.begin(), loop.end());
-        std::vector<SurfacePoint> outline;
-        outline.reserve(loop.size());
-        for (const int v : loop) outline.push_back(vertex_point(mesh, v));
+        const std::vector<SurfacePoint> outline = snake_start_along(std::move(loop));
         schedule.set_barrier(mask.height, mask.level);
         mask_reach = grown_region(mesh, mask.start_region, std::max(h_try, 3 * mesh.average_edge_length()),
                                   tangential_length(mesh, mask.base_normals));

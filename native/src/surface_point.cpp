@@ -56,6 +56,13 @@ SurfacePoint vertex_point(const Mesh& mesh, int v) {
   return p;
 }
 
+std::vector<SurfacePoint> vertex_points(const Mesh& mesh, const std::vector<int>& path) {
+  std::vector<SurfacePoint> points;
+  points.reserve(path.size());
+  for (const int v : path) points.push_back(vertex_point(mesh, v));
+  return points;
+}
+
 Vec3 position(const Mesh& mesh, const SurfacePoint& p) {
   return p.bary[0] * mesh.position(mesh.face_vertex(p.face, 0)) +
          p.bary[1] * mesh.position(mesh.face_vertex(p.face, 1)) +

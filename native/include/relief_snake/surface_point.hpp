@@ -18,6 +18,8 @@ struct SurfacePoint {
 
 /// The point at mesh vertex v (expressed in one of its faces).
 SurfacePoint vertex_point(const Mesh& mesh, int v);
+/// The points at the vertices of `path` (#path), in order.
+std::vector<SurfacePoint> vertex_points(const Mesh& mesh, const std::vector<int>& path);
 /// 3D position of p.
 Vec3 position(const Mesh& mesh, const SurfacePoint& p);
 /// Unit surface normal at p, interpolated from the vertex normals (smooth across edges).
