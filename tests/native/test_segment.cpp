@@ -303,22 +303,20 @@ bool has_note(const Result& r, const std::string& text) {
 // The foot gap (evidence.hpp): a disk blended over 1 h (seven edges per h). With h typed x0.55 the snake
 // settles 4 edges up the slope; before the check it came back converged, now it is doubtful and says
 // why. At x0.6 the check turns down the attempts up the slope and a larger W_int, then the refit, bring
-// the contour to the foot. At the true h the contour is at the foot and the gap is nil. (At x0.55
-// the heights' outline, relief_mask.hpp, then rescues the doubtful contour: the check is seen with it off.)
+// the contour to the foot. At the true h the contour is at the foot and the gap is nil.
 TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
   const syn::ScanSpec spec = wide_blended_disk();
   const syn::Scan scan = syn::generate(spec);
   const Mesh mesh = syn::to_mesh(scan);
   const syn::Picks picks = scan.picks(syn::PickSpec{});
   const double edge = mesh.average_edge_length();
-  auto run = [&](double factor, bool height_outline = true) {
+  auto run = [&](double factor, bool height_outline = false) {
     Options options;
     options.step_height = factor * scan.h;
     options.height_outline = height_outline;
     return segment(mesh, picks.vertices, options);
   };
-  // Without the heights' outline (with it, see below).
-  const Result up = run(0.55, false);
+  const Result up = run(0.55);
   ASSERT_FALSE(up.polyline.empty()) << up.message;
   EXPECT_EQ(up.status, Status::Doubtful);
   bool said = false;
@@ -331,10 +329,10 @@ TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
   EXPECT_EQ(rescued.status, Status::Converged) << rescued.message;
   EXPECT_LT(std::fabs(mean_offset_from_foot(rescued)), 0.5 * edge);  // measured: 0.2 edges
 
-  // With it (the default), x0.55's doubtful contour is refined again from just outside what stands
-  // above the background, and settles within an edge of the foot (the suite's accuracy; measured:
-  // 0.49 edges inside it, against 4 edges up the slope without).
-  const Result outlined = run(0.55);
+  // With the heights' outline (height_outline, off by default), x0.55's doubtful contour is refined
+  // again from just outside what stands above the background, and settles within an edge of the foot
+  // (the suite's accuracy; measured: 0.49 edges inside it, against 4 edges up the slope without).
+  const Result outlined = run(0.55, true);
   EXPECT_EQ(outlined.status, Status::Converged) << outlined.message;
   EXPECT_TRUE(has_note(outlined, "refined again from just outside what stands"));
   EXPECT_LT(std::fabs(mean_offset_from_foot(outlined)), 1.0 * edge);
@@ -540,16 +538,13 @@ TEST(SegmentRefit, AStepMeasuredAgainAtItsOwnHeightKeepsTheContour) {
   EXPECT_LT(scan.options.step_height / found, 2.0);
   EXPECT_TRUE(has_note(result, "again but that contour's evidence was weaker"));
   scan.expect_accurate(result);
-  scan.expect_doubtful_with(
-      [](Options& o) {
-        o.confirmed_step = false;
-        o.height_outline = false;
-      },
-      "far from the step height used");
-  // With the heights' outline (the default), the doubtful result of confirmed_step=0 is refined
-  // again from just outside what stands above the background: that one is right and converged.
+  scan.expect_doubtful_with([](Options& o) { o.confirmed_step = false; }, "far from the step height used");
+  // With the heights' outline (height_outline, off by default), the doubtful result of
+  // confirmed_step=0 is refined again from just outside what stands above the background: that one
+  // is right and converged.
   Options unconfirmed = scan.options;
   unconfirmed.confirmed_step = false;
+  unconfirmed.height_outline = true;
   const Result outlined = scan.run(unconfirmed);
   EXPECT_EQ(outlined.status, Status::Converged) << outlined.message;
   EXPECT_TRUE(has_note(outlined, "refined again from just outside what stands"));
@@ -589,6 +584,15 @@ TEST(SegmentOpen, ASideDecidedWronglyIsSegmentedFromTheOtherSide) {
   EXPECT_EQ(result.relief_side, ReliefSide::Right);
   EXPECT_TRUE(has_note(result, "decided from the surface as left of the picks, but its result failed the self-check"));
   scan.expect_accurate(result);
+  // With the heights' outline on, the decided side's wrong-looking result is not refined from an
+  // outline on the background (that result no longer looked wrong-sided: the right side was never
+  // tried and the result was iteration_cap).
+  Options outlined = decided;
+  outlined.height_outline = true;
+  const Result with_outline = scan.run(outlined);
+  ASSERT_EQ(with_outline.status, Status::Converged) << with_outline.message;
+  EXPECT_EQ(with_outline.relief_side, ReliefSide::Right);
+  scan.expect_accurate(with_outline);
   // The side decided first, named by the user: the self-check says the result is not the relief.
   // (Since the foot test allows for its fit's error, a third h tried there stops at the iteration
   // cap: the result is iteration_cap, with the same reason.)
