@@ -974,6 +974,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   if (best.evidence.coarse_relief_kept >= 0)
     result.checks.push_back({"coarse_relief_kept", best.evidence.coarse_relief_kept});
   if (best.evidence.other_side_share >= 0) result.checks.push_back({"other_side_share", best.evidence.other_side_share});
+  if (best.evidence.beyond_mask_share >= 0) result.checks.push_back({"beyond_mask_share", best.evidence.beyond_mask_share});
   if (!side_given) {
     // The side decision's margin: the side not taken's rise along the picks over the side taken's.
     const double taken = inside_left ? estimate.left_rise : estimate.right_rise;

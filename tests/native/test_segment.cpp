@@ -9,6 +9,7 @@
 #include <string>
 
 #include "relief_snake/error.hpp"
+#include "relief_snake/evidence.hpp"
 #include "relief_snake/segment.hpp"
 #include "synthetic.hpp"
 
@@ -336,10 +337,15 @@ TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
   EXPECT_EQ(outlined.status, Status::Converged) << outlined.message;
   EXPECT_TRUE(has_note(outlined, "refined again from just outside what stands"));
   EXPECT_LT(std::fabs(mean_offset_from_foot(outlined)), 1.0 * edge);
+  // Its leak check is in the result (measured only for a snake from the outline), under the limit.
+  const double beyond = check_value(outlined, "beyond_mask_share");
+  EXPECT_GE(beyond, 0.0);
+  EXPECT_LE(beyond, SelfCheckOptions().max_beyond_mask_share);
 
   const Result right = run(1.0);
   EXPECT_EQ(right.status, Status::Converged) << right.message;
   EXPECT_EQ(check_value(right, "foot_gap_median"), 0.0);
+  EXPECT_TRUE(std::isnan(check_value(right, "beyond_mask_share")));  // not measured: no outline stage
   EXPECT_LT(std::fabs(mean_offset_from_foot(right)), 0.5 * edge);
 }
 
