@@ -32,42 +32,48 @@ Vec3 smooth_inward(const Snake& snake, int i, int span) {
   return m;
 }
 
-// The foot distance (>= 0) outwards from snaxel i along `inward`, or a negative value to leave it.
-double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
-                     std::vector<double>* distances, std::vector<SurfacePoint>* samples, double* band_residual) {
+// The surface's profile outwards from snaxel i along `inward`: heights at `distances` (every h / 20,
+// at least every half edge, out to the band's end), along the band's mean normal, from the band's
+// end. Empty where the walk or the band fails (the mesh ends first, no normal).
+std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
+                                 const std::vector<double>& distances, std::vector<SurfacePoint>* samples) {
   const Mesh& mesh = snake.mesh();
-  if (inward.isZero()) return -1;
-  const double h = o.h;
-  // Samples every h / 20 (and at least every half edge) out to the band's end.
-  const double step = std::min(0.05 * h, 0.5 * mesh.average_edge_length());
-  const int count = static_cast<int>(std::ceil(o.band_to * h / step));
-  distances->resize(count + 1);
-  for (int k = 0; k <= count; ++k) (*distances)[k] = k * step;
+  if (inward.isZero()) return {};
+  const int count = static_cast<int>(distances.size()) - 1;
   WalkOptions walk_options;
-  walk_options.distance = distances->back();
-  walk_options.samples = distances->data();
-  walk_options.n_samples = distances->size();
+  walk_options.distance = distances.back();
+  walk_options.samples = distances.data();
+  walk_options.n_samples = distances.size();
   *samples = walk_points(walk(mesh, snake[i].point, -inward, walk_options));
-  if (static_cast<int>(samples->size()) <= count) return -1;  // the mesh ends before the band does
-
+  if (static_cast<int>(samples->size()) <= count) return {};  // the mesh ends before the band does
   // The background's normal: the surface normal averaged over the band.
-  const int band_start = static_cast<int>(std::ceil(o.band_from * h / step));
+  const int band_start = static_cast<int>(std::ceil(o.band_from * o.h / distances[1]));
   Vec3 n = Vec3::Zero();
   for (int k = band_start; k <= count; ++k) n += normal(mesh, (*samples)[k]);
-  if (!(n.norm() > 0)) return -1;
+  if (!(n.norm() > 0)) return {};
   n.normalize();
   const Vec3 origin = position(mesh, (*samples)[count]);
-  auto height = [&](int k) { return (position(mesh, (*samples)[k]) - origin).dot(n); };
+  std::vector<double> heights(count + 1);
+  for (int k = 0; k <= count; ++k) heights[k] = (position(mesh, (*samples)[k]) - origin).dot(n);
+  return heights;
+}
 
+// The foot distance (>= 0) outwards along a profile (foot_profile's heights at `distances`), or a
+// negative value to leave the snaxel; *band_residual: the band fit's RMS residual.
+double foot_of_profile(const std::vector<double>& heights, const std::vector<double>& distances,
+                       const FootOptions& o, double* band_residual) {
+  const double h = o.h;
+  const int count = static_cast<int>(distances.size()) - 1;
+  const int band_start = static_cast<int>(std::ceil(o.band_from * h / distances[1]));
   // A quadratic profile z(d) = a + b d + c d^2 through the band (least squares, d in h).
   const int m = count - band_start + 1;
-  if (m < 4) return -1;
+  if (m < 4 || static_cast<int>(heights.size()) != count + 1) return -1;
   Eigen::MatrixXd A(m, 3);
   Eigen::VectorXd z(m);
   for (int k = band_start; k <= count; ++k) {
-    const double d = (*distances)[k] / h;
+    const double d = distances[k] / h;
     A.row(k - band_start) << 1.0, d, d * d;
-    z(k - band_start) = height(k);
+    z(k - band_start) = heights[k];
   }
   Eigen::Vector3d coef = A.colPivHouseholderQr().solve(z);
   const double residual = std::sqrt((A * coef - z).squaredNorm() / m);
@@ -91,16 +97,39 @@ double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOp
   }
   // How far sample k stands above the background, beyond what the fit's error explains.
   auto above = [&](int k) {
-    const double d = (*distances)[k] / h;
+    const double d = distances[k] / h;
     const Eigen::Vector3d x(1.0, d, d * d);
     const double threshold = std::max(4 * residual * std::sqrt(1 + x.dot(spread * x)), 0.02 * h);
-    return height(k) - coef.dot(x) - threshold;
+    return heights[k] - coef.dot(x) - threshold;
   };
   if (above(0) <= 0) return 0;  // the snaxel is on the background already (as far as the fit can tell)
   // From the band inwards, the first sample that rises above the background ends it.
   for (int k = band_start - 1; k >= 0; --k)
-    if (above(k) > 0) return k + 1 < band_start ? (*distances)[k + 1] : -1;
+    if (above(k) > 0) return k + 1 < band_start ? distances[k + 1] : -1;
   return 0;
+}
+
+// The pooled profile of snaxel i: per sample, the median of the profiles of the snaxels within
+// `pool` of it along the snake (those that have one); empty with fewer than pool + 1 of them.
+std::vector<double> pooled_profile(const std::vector<std::vector<double>>& profiles, int i, int pool, bool closed) {
+  const int n = static_cast<int>(profiles.size());
+  std::vector<const std::vector<double>*> near;
+  for (int k = -pool; k <= pool; ++k) {
+    int j = i + k;
+    if (closed) j = ((j % n) + n) % n;
+    else if (j < 0 || j >= n) continue;
+    if (!profiles[j].empty()) near.push_back(&profiles[j]);
+  }
+  if (static_cast<int>(near.size()) < pool + 1) return {};
+  const std::size_t length = near.front()->size();
+  std::vector<double> pooled(length), column;
+  for (std::size_t s = 0; s < length; ++s) {
+    column.clear();
+    for (const auto* p : near) column.push_back((*p)[s]);
+    std::nth_element(column.begin(), column.begin() + column.size() / 2, column.end());
+    pooled[s] = column[column.size() / 2];
+  }
+  return pooled;
 }
 
 }  // namespace
@@ -108,15 +137,32 @@ double foot_distance(const Snake& snake, int i, const Vec3& inward, const FootOp
 FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   FootResult result;
   const int n = snake->size();
-  std::vector<double> foot(n, -1), distances;
+  std::vector<double> foot(n, -1);
   std::vector<SurfacePoint> samples;
   std::vector<Vec3> inward(n, Vec3::Zero());
   std::vector<double> residuals;
+  // Samples every h / 20 (and at least every half edge) out to the band's end.
+  const double spacing = std::min(0.05 * o.h, 0.5 * snake->mesh().average_edge_length());
+  const int count = static_cast<int>(std::ceil(o.band_to * o.h / spacing));
+  std::vector<double> distances(count + 1);
+  for (int k = 0; k <= count; ++k) distances[k] = k * spacing;
+  std::vector<std::vector<double>> profiles(n);
   for (int i = 0; i < n; ++i) {
     if (snake->is_end(i)) continue;
     inward[i] = smooth_inward(*snake, i, o.smoothing + 1);
+    profiles[i] = foot_profile(*snake, i, inward[i], o, distances, &samples);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (profiles[i].empty()) continue;
     double residual = -1;
-    foot[i] = foot_distance(*snake, i, inward[i], o, &distances, &samples, &residual);
+    if (o.pool > 0) {
+      // Noise and texture independent from one profile to the next cancel in the median: the band's
+      // residual, and so the threshold, fall with it (a texture that runs along the contour does not).
+      const std::vector<double> pooled = pooled_profile(profiles, i, o.pool, snake->closed());
+      if (!pooled.empty()) foot[i] = foot_of_profile(pooled, distances, o, &residual);
+    } else {
+      foot[i] = foot_of_profile(profiles[i], distances, o, &residual);
+    }
     if (residual >= 0) residuals.push_back(residual);
   }
   // A noisy background hides where the surface leaves it: measured, the snap then puts

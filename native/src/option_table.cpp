@@ -190,6 +190,12 @@ const std::vector<Row>& rows() {
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),
+      number("foot_pool", &Options::foot_pool, "in [0, 5]", [](double x) { return x >= 0 && x <= 5; },
+             "the blended foot stage: pool each snaxel's profile outwards with its neighbours' over this "
+             "length of contour on each side, in h, before finding the foot (0: each alone) (not in the paper)"),
+      number("foot_gate_residual", &Options::foot_gate_residual, "in (0, 1]", [](double x) { return x > 0 && x <= 1; },
+             "the blended foot stage runs where the outside quadrics' residual is under this share of h "
+             "(not in the paper)"),
       boolean("height_outline", &Options::height_outline,
               "closed contours: when no refinement passes the self-check, refine once more from just outside "
               "what stands half a step above the background filled in under the region (not in the paper)"),

@@ -162,10 +162,10 @@ struct Attempt {
 // the way up the slope, and the foot stage brings it down to the foot; on sharp steps (already at
 // the foot), textured or noisy backgrounds (where the foot test fires on the texture) and coarse
 // meshes it only moved right contours off (randomized suite, docs/design.md).
-bool blended_and_clean(const StepEvidence& step, double h, double edge) {
+bool blended_and_clean(const StepEvidence& step, double h, double edge, double max_residual) {
   const bool wide_rise = step.rise_width_median >= 2 * edge && h >= 3 * edge;
   return step.step_share > 0 && (step.offset_median >= 1.5 * edge || wide_rise) &&
-         step.background_quadric_residual <= 0.05 * h;
+         step.background_quadric_residual <= max_residual * h;
 }
 
 // a is better evidence than b.
@@ -534,6 +534,13 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
         // Gated on a blended step, the foot test's own threshold (4 x the band's residual) copes with
         // noise up to the gate's 5% of h: the plain stage's noise limit is for sharp steps and texture.
         if (gated) fo.max_unclean_share = 0.5, fo.max_noise = 0.05;
+        if (gated && options.foot_pool > 0) {
+          // Snaxels within foot_pool h of each other along the contour, from its mean spacing.
+          double length = 0;
+          for (int i = 0; i + 1 < snake.size(); ++i) length += (snake[i + 1].position - snake[i].position).norm();
+          const double spacing = snake.size() > 1 ? length / (snake.size() - 1) : 0;
+          if (spacing > 0) fo.pool = std::clamp(static_cast<int>(std::lround(options.foot_pool * h_try / spacing)), 1, 64);
+        }
         const FootResult foot = settle_at_foot(&snake, fo);
         if (foot.unclean) {
           a.notes.push_back("not settled at the foot: most of the contour has no clean background outside");
@@ -562,7 +569,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
       };
       if (options.foot_snap) settle_at_the_foot(false);
       region_and_step();
-      if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length())) {
+      if (!options.foot_snap && options.foot_snap_blended && blended_and_clean(a.evidence.step, h_try, mesh.average_edge_length(), options.foot_gate_residual)) {
         settle_at_the_foot(true);
         region_and_step();
       }

@@ -22,6 +22,10 @@ struct FootOptions {
   /// No snap at all when more than this share of the snaxels has no clean background band outside:
   /// moving the rest alone makes the contour jagged (measured on the real eyebrow scan).
   double max_unclean_share = 1.0;
+  /// Pool each snaxel's profile with those of the `pool` snaxels on each side along the snake (the
+  /// median per sample) before fitting the band and finding the foot: noise and texture that differ
+  /// from one profile to the next fall out, so the foot shows through them (0: each snaxel alone).
+  int pool = 0;
 };
 
 struct FootResult {

@@ -92,6 +92,11 @@ struct Options {
   /// the step at least 1.5 edges inside it, outside planes' residual under 5% of h); foot_snap
   /// puts it everywhere (not in the paper).
   bool foot_snap_blended = true;
+  /// The blended foot stage pools each snaxel's profile with its neighbours' over this length of
+  /// contour on each side, in h (FootOptions::pool; 0: each snaxel alone; not in the paper).
+  double foot_pool = 0;
+  /// The blended foot stage's gate: the outside quadrics' residual under this share of h.
+  double foot_gate_residual = 0.05;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
   /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
