@@ -117,16 +117,20 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   double seconds = screen.seconds;
   BackgroundInside out;
   if (!screen.measured || deep(screen)) {
-    out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, {}));
+    BackgroundOptions cotangent;
+    cotangent.smoothing = smoothing_;
+    out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, cotangent));
     seconds += out.seconds;
     if (!out.measured) {  // cotangent weights of a sharp wall's projection can be singular
       BackgroundOptions uniform;
+      uniform.smoothing = smoothing_;
       uniform.laplacian = BackgroundLaplacian::Uniform;
       out = measure_background_inside(mesh_, region, h, step, &solver(uniform_, uniform));
       seconds += out.seconds;
     }
     if (deep(out)) {
       BackgroundOptions positions;
+      positions.smoothing = smoothing_;
       positions.model = BackgroundModel::Surface;
       const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(surface_, positions));
       seconds += second.seconds;

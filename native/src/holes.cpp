@@ -207,8 +207,10 @@ HoleRun run_hole(const Mesh& mesh, PlanarityField& planarity, const Options& opt
     if (!(o.area > 0) || inside < 0.9 * o.area || o.area > 0.8 * outer_area) {
       o.check.holds = false;
       o.check.score -= 10;
+      o.leaked = true;
       o.check.reasons.push_back("its contour leaves the relief (it encloses " + fmt(o.area, 3) +
-                                " of area, " + fmt(outer_area > 0 ? o.area / outer_area : 0, 3) + " of the region)");
+                                " of area, " + fmt(outer_area > 0 ? o.area / outer_area : 0, 3) +
+                                " of the region), so it was not cut out");
     }
     o.attempts = attempts;
     const bool holds = o.check.holds;
@@ -400,8 +402,9 @@ HoleSearch segment_holes(const Mesh& mesh, PlanarityField& planarity, const Opti
     }
     run.outcome.from_picks = starts[k].from_picks;
     run.outcome.island_area = starts[k].island_area;
-    for (int v = 0; v < mesh.n_vertices(); ++v)
-      if (run.outcome.interior[v]) region[v] = 0;
+    if (!run.outcome.leaked)  // cutting a leaked hole would take the relief (or all of it) with it
+      for (int v = 0; v < mesh.n_vertices(); ++v)
+        if (run.outcome.interior[v]) region[v] = 0;
     search.holes.push_back(std::move(run.outcome));
   }
   if (search.ignored_small > 0)
@@ -424,7 +427,7 @@ void add_holes(const Mesh& mesh, const HoleSearch& search, Result* result, SelfC
       check->holds = false;
       for (const std::string& reason : hole.check.reasons) check->reasons.push_back(name + ": " + reason);
     }
-    if (hole.contour.empty()) continue;
+    if (hole.contour.empty() || hole.leaked) continue;  // not cut out: no hole in the result
     ++found;
     std::vector<Vec3> polyline;
     for (const SurfacePoint& p : hole.contour) polyline.push_back(mesh.to_file(position(mesh, p)));

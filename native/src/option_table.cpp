@@ -196,6 +196,10 @@ const std::vector<Row>& rows() {
       number("foot_gate_residual", &Options::foot_gate_residual, "in (0, 1]", [](double x) { return x > 0 && x <= 1; },
              "the blended foot stage runs where the outside quadrics' residual is under this share of h "
              "(not in the paper)"),
+      number("region_check_smoothing", &Options::region_check_smoothing, "in [0, 5]",
+             [](double x) { return x >= 0 && x <= 5; },
+             "the region-wide check's background fills: fit the ring's inner band softly over this length, in "
+             "h (0: the ring is fixed exactly) (not in the paper)"),
       boolean("height_outline", &Options::height_outline,
               "closed contours: when no refinement passes the self-check, refine once more from just outside "
               "what stands half a step above the background filled in under the region (not in the paper)"),

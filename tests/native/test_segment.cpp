@@ -479,6 +479,27 @@ struct RandomRun {
 
 }  // namespace
 
+// Random scan 5046: a C with a narrow mouth on a striated plane, one-triangle step, h typed x0.53.
+// With the region-wide check's fills fixed at their ring (region_check_smoothing=0) the snake that
+// bridged the C's mouth fails that check at every W_int, and the hole search on the region it keeps
+// starts a snake on the C's inner floor that leaks out round the relief (it encloses 6 times the
+// region). Cut out, that "hole" emptied the relief (no relief vertex left). It is reported, its
+// check failing, and the relief is kept.
+TEST(SegmentHoles, AHoleThatLeavesTheReliefIsNotCutOut) {
+  const RandomRun scan(5046);
+  ASSERT_EQ(scan.random.draw.axes["shape"], "c");
+  Options options = scan.options;
+  options.region_check_smoothing = 0;
+  const Result result = scan.run(options);
+  EXPECT_EQ(result.status, Status::Doubtful);
+  bool leaked = false;
+  for (const std::string& text : result.reasons) leaked = leaked || text.find("so it was not cut out") != std::string::npos;
+  ASSERT_TRUE(leaked) << result.message;
+  const auto truth = std::count(scan.random.scan.relief.begin(), scan.random.scan.relief.end(), 1);
+  EXPECT_GT(static_cast<long>(result.relief_vertices.size()), truth / 2);
+  EXPECT_GT(scan.score(result).iou, 0.5);
+}
+
 // Random scan 3126: a C on a plane, a blended step 0.7 h wide, noise 0.014 h, h typed x0.96. The
 // foot stage reads the background it fitted outside each snaxel down to the snaxel; read there, a
 // quadratic fit errs by several times its residual, and with a threshold of 4 residuals runs of

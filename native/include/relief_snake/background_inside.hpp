@@ -71,12 +71,16 @@ bool deep_background_piece(double depth, double area, double limit);
 /// true whenever the screen or a fill could measure the region.
 class BackgroundInsideCheck {
  public:
-  explicit BackgroundInsideCheck(const Mesh& mesh) : mesh_(mesh) {}
+  /// smoothing: the fills' BackgroundOptions::smoothing (in h; 0: the ring is fixed exactly).
+  explicit BackgroundInsideCheck(const Mesh& mesh, double smoothing = BackgroundOptions{}.smoothing)
+      : mesh_(mesh), smoothing_(smoothing) {}
   BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit);
+  double smoothing() const { return smoothing_; }
 
  private:
   const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
   const Mesh& mesh_;
+  double smoothing_;
   std::unique_ptr<BackgroundSolver> cotangent_, uniform_, surface_;
 };
 

@@ -50,6 +50,9 @@ struct HoleOutcome {
   double area = 0;                    ///< area of the interior's vertices
   double island_area = 0;             ///< area of the island it started from (0 from picks)
   int attempts = 0;                   ///< refinements tried (W_int values)
+  /// Its contour left the relief (it took in the background round the relief, or most of the
+  /// relief): it is reported, with its check failing, but not cut out of the region.
+  bool leaked = false;
 };
 
 struct HoleSearch {

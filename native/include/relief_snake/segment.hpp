@@ -97,6 +97,10 @@ struct Options {
   double foot_pool = 0;
   /// The blended foot stage's gate: the outside quadrics' residual under this share of h.
   double foot_gate_residual = 0.05;
+  /// The region-wide check's background fills (background_inside.hpp): their ring's inner band is
+  /// fitted softly over this smoothing length, in h (BackgroundOptions::smoothing; 0: the ring is
+  /// fixed exactly).
+  double region_check_smoothing = 0.5;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
   /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
