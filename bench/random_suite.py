@@ -82,14 +82,22 @@ def log(*args):
 
 
 def parse_seeds(text: str) -> list[int]:
-    """"A:B" (A <= seed < B), "A,B,C" or one seed."""
+    """Seeds from a comma list whose items are "A:B" (A <= seed < B) or one seed: "0:200,1000:1200,7"."""
+    seeds: list[int] = []
     try:
-        if ":" in text:
-            a, b = text.split(":", 1)
-            return list(range(int(a), int(b)))
-        return [int(x) for x in text.split(",") if x.strip()]
+        for item in (x.strip() for x in text.split(",")):
+            if not item:
+                continue
+            if ":" in item:
+                a, b = item.split(":", 1)
+                seeds.extend(range(int(a), int(b)))
+            else:
+                seeds.append(int(item))
     except ValueError:
-        raise SystemExit(f"random-suite: --seeds must be A:B or a comma list of whole numbers, got '{text}'")
+        raise SystemExit(f"random-suite: --seeds must be a comma list of A:B ranges or whole numbers, got '{text}'")
+    if not seeds:
+        raise SystemExit(f"random-suite: --seeds names no seed ('{text}'); give e.g. 0:200 or 0:200,1000:1200")
+    return seeds
 
 
 def variant_args(options: str) -> list[str]:
@@ -495,7 +503,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--cli", default="build/relief-snake")
     ap.add_argument("--make-scan", default="build/make-scan")
-    ap.add_argument("--seeds", default="0:200", help="A:B (A <= seed < B) or a comma list")
+    ap.add_argument("--seeds", default="0:200", help="a comma list of A:B ranges (A <= seed < B) and seeds: 0:200,1000:1200")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--variant", action="append", default=[],
                     help="NAME=OPTIONS or a built-in name (" + ", ".join(BUILTIN_VARIANTS) + "); repeatable; "

@@ -123,3 +123,14 @@ MEASURED_AUTO_SIDE_SILENT = 2
 
 def test_auto_side_no_worse_than_measured(auto_side_sample):
     assert_no_worse(auto_side_sample, MEASURED_AUTO_SIDE_ACCURATE, MEASURED_AUTO_SIDE_SILENT)
+
+
+def test_seeds_take_ranges_and_single_seeds_in_one_list():
+    sys.path.insert(0, str(REPO_ROOT))
+    from bench.random_suite import parse_seeds
+
+    assert parse_seeds("0:3,10:12,7") == [0, 1, 2, 10, 11, 7]
+    assert parse_seeds("1000:1020") == list(range(1000, 1020))
+    for bad in ("a:b", "1:x", ","):
+        with pytest.raises(SystemExit, match="--seeds"):
+            parse_seeds(bad)
