@@ -119,11 +119,13 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   if (!screen.measured || deep(screen)) {
     BackgroundOptions cotangent;
     cotangent.smoothing = smoothing_;
+    cotangent.smoothing_band = band_;
     out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, cotangent));
     seconds += out.seconds;
     if (!out.measured) {  // cotangent weights of a sharp wall's projection can be singular
       BackgroundOptions uniform;
       uniform.smoothing = smoothing_;
+      uniform.smoothing_band = band_;
       uniform.laplacian = BackgroundLaplacian::Uniform;
       out = measure_background_inside(mesh_, region, h, step, &solver(uniform_, uniform));
       seconds += out.seconds;
@@ -131,6 +133,7 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
     if (deep(out)) {
       BackgroundOptions positions;
       positions.smoothing = smoothing_;
+      positions.smoothing_band = band_;
       positions.model = BackgroundModel::Surface;
       const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(surface_, positions));
       seconds += second.seconds;

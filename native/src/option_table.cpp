@@ -200,6 +200,10 @@ const std::vector<Row>& rows() {
              [](double x) { return x >= 0 && x <= 5; },
              "the region-wide check's background fills: fit the ring's inner band softly over this length, in "
              "h (0: the ring is fixed exactly) (not in the paper)"),
+      number("region_check_band", &Options::region_check_band, "in [0, 3]",
+             [](double x) { return x >= 0 && x <= 3; },
+             "the region-wide check's background fills: the inner band of their 3 h ring fitted softly, in h "
+             "(3: the whole ring) (not in the paper)"),
       boolean("height_outline", &Options::height_outline,
               "closed contours: when no refinement passes the self-check, refine once more from just outside "
               "what stands half a step above the background filled in under the region (not in the paper)"),

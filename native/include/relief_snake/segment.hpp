@@ -101,6 +101,8 @@ struct Options {
   /// fitted softly over this smoothing length, in h (BackgroundOptions::smoothing; 0: the ring is
   /// fixed exactly).
   double region_check_smoothing = 0.5;
+  /// ... over this inner band of the ring, in h (BackgroundOptions::smoothing_band; the ring is 3 h).
+  double region_check_band = 1;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
   /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
