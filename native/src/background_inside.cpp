@@ -117,23 +117,16 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   double seconds = screen.seconds;
   BackgroundInside out;
   if (!screen.measured || deep(screen)) {
-    BackgroundOptions cotangent;
-    cotangent.smoothing = smoothing_;
-    cotangent.smoothing_band = band_;
-    out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, cotangent));
+    out = measure_background_inside(mesh_, region, h, step, &solver(cotangent_, fill_));
     seconds += out.seconds;
     if (!out.measured) {  // cotangent weights of a sharp wall's projection can be singular
-      BackgroundOptions uniform;
-      uniform.smoothing = smoothing_;
-      uniform.smoothing_band = band_;
+      BackgroundOptions uniform = fill_;
       uniform.laplacian = BackgroundLaplacian::Uniform;
       out = measure_background_inside(mesh_, region, h, step, &solver(uniform_, uniform));
       seconds += out.seconds;
     }
     if (deep(out)) {
-      BackgroundOptions positions;
-      positions.smoothing = smoothing_;
-      positions.smoothing_band = band_;
+      BackgroundOptions positions = fill_;
       positions.model = BackgroundModel::Surface;
       const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(surface_, positions));
       seconds += second.seconds;

@@ -458,10 +458,13 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   double preprocess_seconds = 0, background_seconds = 0;
   // The region-wide check (background_inside.hpp) of an attempt's region, into its evidence.
   auto measure_region_wide = [&](Attempt& a) {
-    if (!cache_->background_inside || cache_->background_inside->smoothing() != options.region_check_smoothing ||
-        cache_->background_inside->band() != options.region_check_band)
-      cache_->background_inside =
-          std::make_unique<BackgroundInsideCheck>(mesh, options.region_check_smoothing, options.region_check_band);
+    BackgroundOptions fill;
+    fill.smoothing = options.region_check_smoothing;
+    fill.smoothing_band = options.region_check_band;
+    const BackgroundInsideCheck* cached = cache_->background_inside.get();
+    if (!cached || cached->fill_options().smoothing != fill.smoothing ||
+        cached->fill_options().smoothing_band != fill.smoothing_band)
+      cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh, fill);
     a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / a.h;
     BackgroundInside inside = cache_->background_inside->measure(
         a.region, a.h, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * a.h);

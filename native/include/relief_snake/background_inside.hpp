@@ -71,19 +71,16 @@ bool deep_background_piece(double depth, double area, double limit);
 /// true whenever the screen or a fill could measure the region.
 class BackgroundInsideCheck {
  public:
-  /// smoothing, band: the fills' BackgroundOptions::smoothing and smoothing_band (in h; smoothing 0:
-  /// the ring is fixed exactly).
-  explicit BackgroundInsideCheck(const Mesh& mesh, double smoothing = BackgroundOptions{}.smoothing,
-                                 double band = BackgroundOptions{}.smoothing_band)
-      : mesh_(mesh), smoothing_(smoothing), band_(band) {}
+  /// fill: the fills' common options (their smoothing and soft band); each fill sets its own
+  /// Laplacian and model on top.
+  explicit BackgroundInsideCheck(const Mesh& mesh, const BackgroundOptions& fill = {}) : mesh_(mesh), fill_(fill) {}
   BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit);
-  double smoothing() const { return smoothing_; }
-  double band() const { return band_; }
+  const BackgroundOptions& fill_options() const { return fill_; }
 
  private:
   const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
   const Mesh& mesh_;
-  double smoothing_, band_;
+  BackgroundOptions fill_;
   std::unique_ptr<BackgroundSolver> cotangent_, uniform_, surface_;
 };
 
