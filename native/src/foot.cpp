@@ -34,9 +34,11 @@ Vec3 smooth_inward(const Snake& snake, int i, int span) {
 
 // The surface's profile outwards from snaxel i along `inward`: heights at `distances` (every h / 20,
 // at least every half edge, out to the band's end), along the band's mean normal, from the band's
-// end. Empty where the walk or the band fails (the mesh ends first, no normal).
+// end, after `inner` heights read inwards of the snaxel at the same spacing (the innermost first).
+// Empty where the walk or the band fails (the mesh ends first, no normal).
 std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
-                                 const std::vector<double>& distances, std::vector<SurfacePoint>* samples) {
+                                 const std::vector<double>& distances, int inner,
+                                 std::vector<SurfacePoint>* samples) {
   const Mesh& mesh = snake.mesh();
   if (inward.isZero()) return {};
   const int count = static_cast<int>(distances.size()) - 1;
@@ -46,6 +48,15 @@ std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, 
   walk_options.n_samples = distances.size();
   *samples = walk_points(walk(mesh, snake[i].point, -inward, walk_options));
   if (static_cast<int>(samples->size()) <= count) return {};  // the mesh ends before the band does
+  std::vector<SurfacePoint> inside;
+  if (inner > 0) {  // distances[1 .. inner] inwards
+    WalkOptions in_options;
+    in_options.distance = distances[inner];
+    in_options.samples = distances.data() + 1;
+    in_options.n_samples = inner;
+    inside = walk_points(walk(mesh, snake[i].point, inward, in_options));
+    if (static_cast<int>(inside.size()) < inner) return {};
+  }
   // The background's normal: the surface normal averaged over the band.
   const int band_start = static_cast<int>(std::ceil(o.band_from * o.h / distances[1]));
   Vec3 n = Vec3::Zero();
@@ -53,21 +64,24 @@ std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, 
   if (!(n.norm() > 0)) return {};
   n.normalize();
   const Vec3 origin = position(mesh, (*samples)[count]);
-  std::vector<double> heights(count + 1);
-  for (int k = 0; k <= count; ++k) heights[k] = (position(mesh, (*samples)[k]) - origin).dot(n);
+  std::vector<double> heights(inner + count + 1);
+  for (int j = 0; j < inner; ++j) heights[inner - 1 - j] = (position(mesh, inside[j]) - origin).dot(n);
+  for (int k = 0; k <= count; ++k) heights[inner + k] = (position(mesh, (*samples)[k]) - origin).dot(n);
   return heights;
 }
 
-// The foot distance (>= 0) outwards along a profile (foot_profile's heights at `distances`), or a
-// negative value to leave the snaxel; *band_residual: the band fit's RMS residual.
-double foot_of_profile(const std::vector<double>& heights, const std::vector<double>& distances,
-                       const FootOptions& o, double* band_residual) {
+// The foot distance (>= 0) outwards along a profile (foot_profile's heights: `inner` samples inwards of
+// the snaxel, then those at `distances`), or a negative value to leave the snaxel; *band_residual: the
+// band fit's RMS residual; *toe_fitted: the toe's fit placed the foot (FootOptions::toe).
+double foot_of_profile(const std::vector<double>& profile, int inner, const std::vector<double>& distances,
+                       const FootOptions& o, double* band_residual, bool* toe_fitted) {
   const double h = o.h;
   const int count = static_cast<int>(distances.size()) - 1;
   const int band_start = static_cast<int>(std::ceil(o.band_from * h / distances[1]));
   // A quadratic profile z(d) = a + b d + c d^2 through the band (least squares, d in h).
   const int m = count - band_start + 1;
-  if (m < 4 || static_cast<int>(heights.size()) != count + 1) return -1;
+  if (m < 4 || static_cast<int>(profile.size()) != inner + count + 1) return -1;
+  const double* heights = profile.data() + inner;  // heights[k] at distances[k]; k < 0 inwards
   Eigen::MatrixXd A(m, 3);
   Eigen::VectorXd z(m);
   for (int k = band_start; k <= count; ++k) {
@@ -95,18 +109,56 @@ double foot_of_profile(const std::vector<double>& heights, const std::vector<dou
     spread.setZero();
     spread.topLeftCorner<2, 2>() = (line.transpose() * line).inverse();
   }
-  // How far sample k stands above the background, beyond what the fit's error explains.
-  auto above = [&](int k) {
-    const double d = distances[k] / h;
-    const Eigen::Vector3d x(1.0, d, d * d);
-    const double threshold = std::max(4 * residual * std::sqrt(1 + x.dot(spread * x)), 0.02 * h);
-    return heights[k] - coef.dot(x) - threshold;
+  const double spacing = distances[1];
+  // Sample k's rise above the background, and the rise the fit's error explains there.
+  auto rise = [&](int k) {
+    const double d = k * spacing / h;
+    return heights[k] - coef.dot(Eigen::Vector3d(1.0, d, d * d));
   };
-  if (above(0) <= 0) return 0;  // the snaxel is on the background already (as far as the fit can tell)
-  // From the band inwards, the first sample that rises above the background ends it.
-  for (int k = band_start - 1; k >= 0; --k)
-    if (above(k) > 0) return k + 1 < band_start ? distances[k + 1] : -1;
-  return 0;
+  auto threshold = [&](int k) {
+    const double d = k * spacing / h;
+    const Eigen::Vector3d x(1.0, d, d * d);
+    return std::max(4 * residual * std::sqrt(1 + x.dot(spread * x)), 0.02 * h);
+  };
+  auto above = [&](int k) { return rise(k) - threshold(k); };
+  // From the band inwards, the first sample that rises above the background ends it (crossing).
+  int crossing = 0;  // 0: the snaxel is on the background already (as far as the fit can tell)
+  double foot = 0;
+  if (above(0) > 0) {
+    crossing = -1;
+    for (int k = band_start - 1; k >= 0 && crossing < 0; --k)
+      if (above(k) > 0) crossing = k;
+    if (crossing + 1 >= band_start) return -1;
+    foot = distances[crossing + 1];
+  } else if (inner > 0) {
+    for (int k = -1; k >= -inner && crossing == 0; --k)
+      if (above(k) > 0) crossing = k;
+    if (crossing == 0) return 0;
+  } else {
+    return 0;
+  }
+  if (inner == 0) return foot;
+  // The toe: sqrt(rise) along the samples from the crossing inwards, while they stay above the
+  // threshold and under the cap, fitted by a line in the distance; where it meets zero is the foot.
+  double sd = 0, sr = 0, sdd = 0, sdr = 0;
+  int used = 0;
+  for (int k = crossing; k >= -inner; --k) {
+    const double r = rise(k);
+    if (!(r > threshold(k)) || r >= o.toe_cap * h) break;
+    const double d = k * spacing, q = std::sqrt(r);
+    sd += d, sr += q, sdd += d * d, sdr += d * q, ++used;
+  }
+  if (used < o.toe_min_samples) return foot;
+  const double var = sdd - sd * sd / used, cov = sdr - sd * sr / used;
+  if (!(var > 0) || !(cov < 0)) return foot;  // sqrt(rise) must grow inwards
+  const double slope = cov / var, intercept = (sr - slope * sd) / used;
+  const double toe = -intercept / slope;
+  const double limit = distances[band_start - 1];
+  if (toe > foot) {
+    foot = std::min(toe, limit);
+    *toe_fitted = true;
+  }
+  return foot;
 }
 
 // The pooled profile of snaxel i: per sample, the median of the profiles of the snaxels within
@@ -146,23 +198,26 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   const int count = static_cast<int>(std::ceil(o.band_to * o.h / spacing));
   std::vector<double> distances(count + 1);
   for (int k = 0; k <= count; ++k) distances[k] = k * spacing;
+  const int inner = o.toe ? std::min(count, static_cast<int>(std::ceil(o.toe_inner * o.h / spacing))) : 0;
   std::vector<std::vector<double>> profiles(n);
   for (int i = 0; i < n; ++i) {
     if (snake->is_end(i)) continue;
     inward[i] = smooth_inward(*snake, i, o.smoothing + 1);
-    profiles[i] = foot_profile(*snake, i, inward[i], o, distances, &samples);
+    profiles[i] = foot_profile(*snake, i, inward[i], o, distances, inner, &samples);
   }
   for (int i = 0; i < n; ++i) {
     if (profiles[i].empty()) continue;
     double residual = -1;
+    bool toe = false;
     if (o.pool > 0) {
       // Noise and texture independent from one profile to the next cancel in the median: the band's
       // residual, and so the threshold, fall with it (a texture that runs along the contour does not).
       const std::vector<double> pooled = pooled_profile(profiles, i, o.pool, snake->closed());
-      if (!pooled.empty()) foot[i] = foot_of_profile(pooled, distances, o, &residual);
+      if (!pooled.empty()) foot[i] = foot_of_profile(pooled, inner, distances, o, &residual, &toe);
     } else {
-      foot[i] = foot_of_profile(profiles[i], distances, o, &residual);
+      foot[i] = foot_of_profile(profiles[i], inner, distances, o, &residual, &toe);
     }
+    if (toe) ++result.toe_fitted;
     if (residual >= 0) residuals.push_back(residual);
   }
   // A noisy background hides where the surface leaves it: measured, the snap then puts

@@ -539,7 +539,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
         fo.h = h_try;
         // Gated on a blended step, the foot test's own threshold (4 x the band's residual) copes with
         // noise up to the gate's 5% of h: the plain stage's noise limit is for sharp steps and texture.
-        if (gated) fo.max_unclean_share = 0.5, fo.max_noise = 0.05;
+        if (gated) fo.max_unclean_share = 0.5, fo.max_noise = 0.05, fo.toe = options.foot_toe;
         if (gated && options.foot_pool > 0) {
           // Snaxels within foot_pool h of each other along the contour, from its mean spacing.
           double length = 0;
@@ -564,7 +564,8 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
         else
           a.notes.push_back("settled at the foot: " + std::to_string(foot.moved) + " snaxels moved out by " +
                             fmt(foot.mean_move / h_try) + " h on average, " + std::to_string(foot.skipped) +
-                            " left (no clean background outside)");
+                            " left (no clean background outside)" +
+                            (foot.toe_fitted > 0 ? ", " + std::to_string(foot.toe_fitted) + " placed by the step's toe" : ""));
         a.run.contour = snake.points();
       };
       // The region the contour cuts, the snaxels on a sharp wall moved down it, the step measured.

@@ -26,6 +26,17 @@ struct FootOptions {
   /// median per sample) before fitting the band and finding the foot: noise and texture that differ
   /// from one profile to the next fall out, so the foot shows through them (0: each snaxel alone).
   int pool = 0;
+  /// The toe (not in the paper): a blend tangent to the background (a smoothstep, a fillet) leaves it
+  /// along a quadratic toe, so the surface only clears the threshold some way inside the true foot (on
+  /// the randomized suite's blended steps, 1.5 to 2 edges of 10). With `toe`, the profile is also read
+  /// up to `toe_inner` h inwards of the snaxel, and the square root of the rise above the background,
+  /// over the samples from the threshold crossing inwards that rise less than `toe_cap` h, is fitted
+  /// by a line: where it meets zero is the foot (never inside the crossing, never into the band).
+  /// A straight ramp's square root bends the other way, so the line stops short of its foot.
+  bool toe = false;
+  double toe_inner = 0.3;
+  double toe_cap = 0.25;
+  int toe_min_samples = 3;  ///< fewer samples in the toe: the crossing stands
 };
 
 struct FootResult {
@@ -35,6 +46,7 @@ struct FootResult {
   double background_residual = 0;  ///< median residual of the background fits
   bool noisy = false;        ///< nothing moved: the background is too noisy
   bool unclean = false;      ///< nothing moved: too few snaxels have a clean background outside
+  int toe_fitted = 0;        ///< snaxels whose foot the toe's fit placed (FootOptions::toe)
 };
 
 /// Down a sharp step's wall (not in the paper). A sharp step one triangle wide stands on faces that
