@@ -121,22 +121,17 @@ double foot_of_profile(const std::vector<double>& profile, int inner, const std:
     return std::max(4 * residual * std::sqrt(1 + x.dot(spread * x)), 0.02 * h);
   };
   auto above = [&](int k) { return rise(k) - threshold(k); };
-  // From the band inwards, the first sample that rises above the background ends it (crossing).
-  int crossing = 0;  // 0: the snaxel is on the background already (as far as the fit can tell)
-  double foot = 0;
-  if (above(0) > 0) {
-    crossing = -1;
-    for (int k = band_start - 1; k >= 0 && crossing < 0; --k)
-      if (above(k) > 0) crossing = k;
-    if (crossing + 1 >= band_start) return -1;
-    foot = distances[crossing + 1];
-  } else if (inner > 0) {
-    for (int k = -1; k >= -inner && crossing == 0; --k)
-      if (above(k) > 0) crossing = k;
-    if (crossing == 0) return 0;
-  } else {
-    return 0;
-  }
+  // The crossing: from the band inwards, the first sample that rises above the background ends it.
+  // A snaxel on the background already (as far as the fit can tell) stays, unless the toe is read:
+  // then the crossing is looked for inwards of it.
+  const bool risen = above(0) > 0;
+  int crossing = 0;
+  bool found = false;
+  for (int k = risen ? band_start - 1 : -1; k >= -inner && !found; --k)
+    if (above(k) > 0) crossing = k, found = true;
+  if (!found) return 0;
+  if (crossing + 1 >= band_start) return -1;
+  double foot = crossing >= 0 ? distances[crossing + 1] : 0.0;
   if (inner == 0) return foot;
   // The toe: sqrt(rise) along the samples from the crossing inwards, while they stay above the
   // threshold and under the cap, fitted by a line in the distance; where it meets zero is the foot.
