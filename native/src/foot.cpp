@@ -38,7 +38,7 @@ Vec3 smooth_inward(const Snake& snake, int i, int span) {
 // Empty where the walk or the band fails (the mesh ends first, no normal).
 std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
                                  const std::vector<double>& distances, int inner,
-                                 std::vector<SurfacePoint>* samples) {
+                                 std::vector<SurfacePoint>* samples, std::vector<double>* across) {
   const Mesh& mesh = snake.mesh();
   if (inward.isZero()) return {};
   const int count = static_cast<int>(distances.size()) - 1;
@@ -67,14 +67,25 @@ std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, 
   std::vector<double> heights(inner + count + 1);
   for (int j = 0; j < inner; ++j) heights[inner - 1 - j] = (position(mesh, inside[j]) - origin).dot(n);
   for (int k = 0; k <= count; ++k) heights[inner + k] = (position(mesh, (*samples)[k]) - origin).dot(n);
+  // Each sample's distance from the snaxel across the background (in the band's plane; negative
+  // inwards): up a steep blend a walk along the surface covers much less than its length across.
+  across->assign(heights.size(), 0.0);
+  const Vec3 start = position(mesh, (*samples)[0]);
+  auto flat = [&](const Vec3& p) {
+    const Vec3 d = p - start;
+    return (d - d.dot(n) * n).norm();
+  };
+  for (int j = 0; j < inner; ++j) (*across)[inner - 1 - j] = -flat(position(mesh, inside[j]));
+  for (int k = 0; k <= count; ++k) (*across)[inner + k] = flat(position(mesh, (*samples)[k]));
   return heights;
 }
 
 // The foot distance (>= 0) outwards along a profile (foot_profile's heights: `inner` samples inwards of
 // the snaxel, then those at `distances`), or a negative value to leave the snaxel; *band_residual: the
 // band fit's RMS residual; *toe_fitted: the toe's fit placed the foot (FootOptions::toe).
-double foot_of_profile(const std::vector<double>& profile, int inner, const std::vector<double>& distances,
-                       const FootOptions& o, double* band_residual, bool* toe_fitted) {
+double foot_of_profile(const std::vector<double>& profile, const std::vector<double>& across_profile, int inner,
+                       const std::vector<double>& distances, const FootOptions& o, double* band_residual,
+                       bool* toe_fitted) {
   const double h = o.h;
   const int count = static_cast<int>(distances.size()) - 1;
   const int band_start = static_cast<int>(std::ceil(o.band_from * h / distances[1]));
@@ -134,20 +145,32 @@ double foot_of_profile(const std::vector<double>& profile, int inner, const std:
   double foot = crossing >= 0 ? distances[crossing + 1] : 0.0;
   if (inner == 0) return foot;
   // The toe: sqrt(rise) along the samples from the crossing inwards, while they stay above the
-  // threshold and under the cap, fitted by a line in the distance; where it meets zero is the foot.
+  // threshold and under the cap, fitted by a line in the distance across the background (not the
+  // distance walked, which up the blend's slope grows faster and bends the square root the wrong
+  // way: the line then met zero up to half an h past the foot); where it meets zero is the foot.
+  const double* across = across_profile.data() + inner;
   double sd = 0, sr = 0, sdd = 0, sdr = 0;
   int used = 0;
   for (int k = crossing; k >= -inner; --k) {
     const double r = rise(k);
     if (!(r > threshold(k)) || r >= o.toe_cap * h) break;
-    const double d = k * spacing, q = std::sqrt(r);
+    const double d = across[k], q = std::sqrt(r);
     sd += d, sr += q, sdd += d * d, sdr += d * q, ++used;
   }
   if (used < o.toe_min_samples) return foot;
   const double var = sdd - sd * sd / used, cov = sdr - sd * sr / used;
   if (!(var > 0) || !(cov < 0)) return foot;  // sqrt(rise) must grow inwards
   const double slope = cov / var, intercept = (sr - slope * sd) / used;
-  const double toe = -intercept / slope;
+  const double toe_across = -intercept / slope;
+  // Back to distance walked outwards, where the samples' distances across bracket it.
+  double toe = distances[band_start - 1];
+  for (int k = std::max(crossing, 0); k + 1 < band_start; ++k)
+    if (toe_across <= across[k + 1]) {
+      const double span = across[k + 1] - across[k];
+      const double t = span > 0 ? std::clamp((toe_across - across[k]) / span, 0.0, 1.0) : 0.0;
+      toe = distances[k] + t * (distances[k + 1] - distances[k]);
+      break;
+    }
   const double limit = distances[band_start - 1];
   if (toe > foot) {
     foot = std::min(toe, limit);
@@ -194,11 +217,11 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
   std::vector<double> distances(count + 1);
   for (int k = 0; k <= count; ++k) distances[k] = k * spacing;
   const int inner = o.toe ? std::min(count, static_cast<int>(std::ceil(o.toe_inner * o.h / spacing))) : 0;
-  std::vector<std::vector<double>> profiles(n);
+  std::vector<std::vector<double>> profiles(n), acrosses(n);
   for (int i = 0; i < n; ++i) {
     if (snake->is_end(i)) continue;
     inward[i] = smooth_inward(*snake, i, o.smoothing + 1);
-    profiles[i] = foot_profile(*snake, i, inward[i], o, distances, inner, &samples);
+    profiles[i] = foot_profile(*snake, i, inward[i], o, distances, inner, &samples, &acrosses[i]);
   }
   for (int i = 0; i < n; ++i) {
     if (profiles[i].empty()) continue;
@@ -208,9 +231,10 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
       // Noise and texture independent from one profile to the next cancel in the median: the band's
       // residual, and so the threshold, fall with it (a texture that runs along the contour does not).
       const std::vector<double> pooled = pooled_profile(profiles, i, o.pool, snake->closed());
-      if (!pooled.empty()) foot[i] = foot_of_profile(pooled, inner, distances, o, &residual, &toe);
+      const std::vector<double> pooled_across = pooled_profile(acrosses, i, o.pool, snake->closed());
+      if (!pooled.empty()) foot[i] = foot_of_profile(pooled, pooled_across, inner, distances, o, &residual, &toe);
     } else {
-      foot[i] = foot_of_profile(profiles[i], inner, distances, o, &residual, &toe);
+      foot[i] = foot_of_profile(profiles[i], acrosses[i], inner, distances, o, &residual, &toe);
     }
     if (toe) ++result.toe_fitted;
     if (residual >= 0) residuals.push_back(residual);

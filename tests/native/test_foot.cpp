@@ -132,3 +132,35 @@ TEST(Foot, PooledProfilesFindTheFootThroughNoise) {
   settle_at_foot(&outside, o);
   EXPECT_NEAR(mean_radius(outside), before, 0.03);
 }
+
+// The toe (FootOptions::toe): a smoothstep as wide as the step is tall, on a scan with about 9 edges
+// per h, leaves the background so gently that the surface clears the threshold only some way inside
+// the true foot; the toe's fit of the square root of the rise carries the snaxels out to the foot.
+// Fitted against the distance walked along the surface instead of the distance across, it overshot:
+// the contour ended 0.68 edges outside the foot (the blend's slope, up to 1.5, stretches the walk).
+TEST(Foot, TheToeFindsTheFootOfATangentBlend) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.h = 4;  // the disk's radius stays 12: the blend runs from r = 8 (top) out to r = 12 (foot)
+  spec.blend_width = 1.0;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  const double edge = mesh.average_edge_length();
+  FootOptions o;
+  o.h = scan.h;
+  Snake crossing = circle_snake(mesh, scan, 11.0, 150);  // a quarter h in, 0.16 h up the blend
+  const FootResult plain = settle_at_foot(&crossing, o);
+  o.toe = true;
+  Snake toe = circle_snake(mesh, scan, 11.0, 150);
+  const FootResult fitted = settle_at_foot(&toe, o);
+  EXPECT_EQ(plain.toe_fitted, 0);
+  EXPECT_GT(fitted.toe_fitted, 100);
+  EXPECT_GT(12.0 - mean_radius(crossing), 0.3 * edge);        // the crossing stops inside the foot
+  // The toe comes nearer the foot than the crossing, within a third of an edge (measured: the crossing
+  // 0.38 edges inside, the toe 0.25 edges outside; the square root of the smoothstep's toe is concave, so
+  // the line meets zero a little outside).
+  EXPECT_LT(std::fabs(mean_radius(toe) - 12.0), 12.0 - mean_radius(crossing));
+  EXPECT_LT(std::fabs(mean_radius(toe) - 12.0), edge / 3);
+}
