@@ -35,7 +35,8 @@ Vec3 smooth_inward(const Snake& snake, int i, int span) {
 // The surface's profile outwards from snaxel i along `inward`: heights at `distances` (every h / 20,
 // at least every half edge, out to the band's end), along the band's mean normal, from the band's
 // end, after `inner` heights read inwards of the snaxel at the same spacing (the innermost first).
-// Empty where the walk or the band fails (the mesh ends first, no normal).
+// *across: with inner > 0, the samples' distances across the background (empty otherwise). Empty
+// where the walk or the band fails (the mesh ends first, no normal).
 std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, const FootOptions& o,
                                  const std::vector<double>& distances, int inner,
                                  std::vector<SurfacePoint>* samples, std::vector<double>* across) {
@@ -67,9 +68,12 @@ std::vector<double> foot_profile(const Snake& snake, int i, const Vec3& inward, 
   std::vector<double> heights(inner + count + 1);
   for (int j = 0; j < inner; ++j) heights[inner - 1 - j] = (position(mesh, inside[j]) - origin).dot(n);
   for (int k = 0; k <= count; ++k) heights[inner + k] = (position(mesh, (*samples)[k]) - origin).dot(n);
-  // Each sample's distance from the snaxel across the background (in the band's plane; negative
-  // inwards): up a steep blend a walk along the surface covers much less than its length across.
-  across->assign(heights.size(), 0.0);
+  // With the toe read, each sample's distance from the snaxel across the background (in the band's
+  // plane; negative inwards): up a steep blend a walk along the surface covers much less than its
+  // length across.
+  across->clear();
+  if (inner == 0) return heights;
+  across->resize(heights.size());
   const Vec3 start = position(mesh, (*samples)[0]);
   auto flat = [&](const Vec3& p) {
     const Vec3 d = p - start;
@@ -162,7 +166,8 @@ double foot_of_profile(const std::vector<double>& profile, const std::vector<dou
   if (!(var > 0) || !(cov < 0)) return foot;  // sqrt(rise) must grow inwards
   const double slope = cov / var, intercept = (sr - slope * sd) / used;
   const double toe_across = -intercept / slope;
-  // Back to distance walked outwards, where the samples' distances across bracket it.
+  // Back to distance walked outwards, where the samples' distances across bracket it (the band's
+  // inner end at most).
   double toe = distances[band_start - 1];
   for (int k = std::max(crossing, 0); k + 1 < band_start; ++k)
     if (toe_across <= across[k + 1]) {
@@ -171,9 +176,8 @@ double foot_of_profile(const std::vector<double>& profile, const std::vector<dou
       toe = distances[k] + t * (distances[k + 1] - distances[k]);
       break;
     }
-  const double limit = distances[band_start - 1];
   if (toe > foot) {
-    foot = std::min(toe, limit);
+    foot = toe;
     *toe_fitted = true;
   }
   return foot;
@@ -231,7 +235,8 @@ FootResult settle_at_foot(Snake* snake, const FootOptions& o) {
       // Noise and texture independent from one profile to the next cancel in the median: the band's
       // residual, and so the threshold, fall with it (a texture that runs along the contour does not).
       const std::vector<double> pooled = pooled_profile(profiles, i, o.pool, snake->closed());
-      const std::vector<double> pooled_across = pooled_profile(acrosses, i, o.pool, snake->closed());
+      const std::vector<double> pooled_across = inner > 0 ? pooled_profile(acrosses, i, o.pool, snake->closed())
+                                                          : std::vector<double>{};
       if (!pooled.empty()) foot[i] = foot_of_profile(pooled, pooled_across, inner, distances, o, &residual, &toe);
     } else {
       foot[i] = foot_of_profile(profiles[i], acrosses[i], inner, distances, o, &residual, &toe);

@@ -31,7 +31,9 @@ struct FootOptions {
   /// the randomized suite's blended steps, 1.5 to 2 edges of 10). With `toe`, the profile is also read
   /// up to `toe_inner` h inwards of the snaxel, and the square root of the rise above the background,
   /// over the samples from the threshold crossing inwards that rise less than `toe_cap` h, is fitted
-  /// by a line: where it meets zero is the foot (never inside the crossing, never into the band).
+  /// by a line against their distance across the background (not walked along the surface, which up
+  /// the blend's slope stretches): where it meets zero is the foot (never inside the crossing, never
+  /// into the band).
   /// A straight ramp's square root bends the other way, so the line stops short of its foot.
   bool toe = false;
   double toe_inner = 0.3;

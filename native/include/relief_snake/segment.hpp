@@ -98,8 +98,8 @@ struct Options {
   /// The blended foot stage's gate: the outside quadrics' residual under this share of h.
   double foot_gate_residual = 0.05;
   /// The blended foot stage reads the step's quadratic toe inwards of the threshold crossing and puts
-  /// the foot where it meets the background (FootOptions::toe; not in the paper). Off: on the
-  /// randomized suite it pushed right contours past the foot (docs/design.md, "The toe").
+  /// the foot where it meets the background (FootOptions::toe; not in the paper). Off until measured
+  /// no worse on the whole randomized suite (docs/design.md, "The toe").
   bool foot_toe = false;
   /// The region-wide check's background fills (background_inside.hpp): their ring's inner band is
   /// fitted softly over this smoothing length, in h (BackgroundOptions::smoothing; 0: the ring is
