@@ -2,6 +2,7 @@
 #include "relief_snake/evidence.hpp"
 
 #include "relief_snake/background_inside.hpp"
+#include "relief_snake/mesh_graph.hpp"
 #include "relief_snake/plane_fit.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -210,6 +211,9 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   std::vector<double> heights;
   std::vector<int> outside, near_outside, far_outside;
   std::vector<double> quadric_residuals;
+  std::vector<int> clear_outside;  // the outside vertices the quadric is fitted to
+  const std::vector<char> near_region =
+      options.quadric_clearance > 0 ? grown_region(mesh, region, options.quadric_clearance * h) : std::vector<char>{};
   const double gap_bin = std::max(edge, radius / 1024);  // one edge (at most 1024 bins across the ball)
   std::vector<std::vector<double>> gap_bins(static_cast<std::size_t>(radius / gap_bin) + 1);
   const double gap_from = std::max(options.foot_gap_from * h, options.foot_gap_from_edges * edge);
@@ -263,7 +267,17 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       continue;
     const Vec3 mean = plane.centroid, normal = plane.normal;
     const double residual = plane.residual();
-    quadric_residuals.push_back(std::min(residual, quadric_residual(mesh, outside, plane, h)));
+    if (near_region.empty()) {
+      quadric_residuals.push_back(std::min(residual, quadric_residual(mesh, outside, plane, h)));
+    } else {
+      clear_outside.clear();
+      for (const int v : outside)
+        if (!near_region[v]) clear_outside.push_back(v);
+      const VertexPlaneFit clear_plane = fit_vertex_plane(mesh, clear_outside);
+      if (static_cast<int>(clear_outside.size()) >= options.min_side_vertices && clear_plane.weight > 0)
+        quadric_residuals.push_back(
+            std::min(clear_plane.residual(), quadric_residual(mesh, clear_outside, clear_plane, h)));
+    }
 
     heights.clear();
     for (const int v : ball)

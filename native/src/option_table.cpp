@@ -196,6 +196,9 @@ const std::vector<Row>& rows() {
       number("foot_gate_residual", &Options::foot_gate_residual, "in (0, 1]", [](double x) { return x > 0 && x <= 1; },
              "the blended foot stage runs where the outside quadrics' residual is under this share of h "
              "(not in the paper)"),
+      number("foot_gate_clearance", &Options::foot_gate_clearance, "in [0, 2]", [](double x) { return x >= 0 && x <= 2; },
+             "the blended foot stage's gate measures the outside quadrics' residual on the vertices at least "
+             "this many h from the region (0: all outside vertices) (not in the paper)"),
       boolean("foot_toe", &Options::foot_toe,
               "the blended foot stage: fit the step's quadratic toe inwards of where it clears the background "
               "and put the foot where the toe meets it (not in the paper)"),

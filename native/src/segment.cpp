@@ -454,6 +454,7 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   step_confirmed_contour_wise.max_edge_step_ratio = step_confirmed.max_edge_step_ratio;
   EvidenceOptions evidence_options;
   evidence_options.closed = options.closed;
+  evidence_options.quadric_clearance = options.foot_gate_clearance;
 
   double preprocess_seconds = 0, background_seconds = 0;
   // The region-wide check (background_inside.hpp) of an attempt's region, into its evidence.

@@ -162,6 +162,42 @@ TEST(Evidence, TheQuadricResidualSeesTextureNotCurvature) {
   EXPECT_LE(textured.background_quadric_residual, textured.background_residual);
 }
 
+// A region short of a blended step's foot leaves the toe of the slope outside it all along the
+// contour; with the clearance (EvidenceOptions::quadric_clearance, the foot stage's gate) the
+// roughness is measured beyond it, on the clean background.
+TEST(Evidence, TheQuadricResidualClearsTheToeLeftOutside) {
+  syn::ScanSpec spec;
+  spec.shape = syn::Shape::Disk;
+  spec.step = syn::Step::Blended;
+  spec.blend_width = 1.0;
+  spec.background = syn::Background::Cylinder;
+  spec.h = 2.0;
+  spec.triangles = 60000;
+  const syn::Scan scan = syn::generate(spec);
+  const Mesh mesh = syn::to_mesh(scan);
+  // Measured: a contour 0.2, 0.35 and 0.5 h up the slope reads 0.023, 0.048 and 0.069 h over all
+  // the outside vertices, 0.0001, 0.013 and 0.030 h beyond 0.5 h of the region.
+  for (const double inside : {0.0, 0.2, 0.35, 0.5}) {
+    SCOPED_TRACE("contour " + std::to_string(inside) + " h inside the foot");
+    const std::vector<SurfacePoint> contour = level_set_contour(scan, mesh, -inside * scan.h);
+    const std::vector<char> region = relief_region(mesh, contour, true, contour_orientation_left(mesh, contour));
+    EvidenceOptions clear;
+    clear.quadric_clearance = 0.5;
+    const double all = measure_step(mesh, contour, region, scan.h).background_quadric_residual;
+    const double beyond = measure_step(mesh, contour, region, scan.h, clear).background_quadric_residual;
+    if (inside == 0.0) {
+      EXPECT_LT(all, 0.01 * scan.h);  // at the foot nothing of the slope lies outside
+      EXPECT_LT(beyond, 0.01 * scan.h);
+    } else {
+      EXPECT_LT(beyond, 0.5 * all);
+    }
+    if (inside == 0.5) {
+      EXPECT_GT(all, 0.05 * scan.h);    // the default gate (foot_gate_residual) shut ...
+      EXPECT_LT(beyond, 0.05 * scan.h); // ... and open beyond the toe
+    }
+  }
+}
+
 TEST(Evidence, AContourInsideTheReliefOrOnTheBackgroundShowsNoStep) {
   const syn::Scan scan = disk_scan(syn::Background::Cylinder, syn::Step::Sharp);
   const Mesh mesh = syn::to_mesh(scan);

@@ -57,6 +57,11 @@ struct EvidenceOptions {
   double knee_bin = 0.1;
   double knee_min_slope = 0.6;
   double knee_relative_slope = 0.35;
+  /// The background's roughness (StepEvidence::background_quadric_residual) leaves out the outside
+  /// vertices within this many h of the region along edges (0: none left out). A region short of a
+  /// blended step's foot leaves the toe of the slope outside it all along the contour, and its heights
+  /// count as roughness.
+  double quadric_clearance = 0;
 };
 
 /// One measured contour point.

@@ -97,6 +97,9 @@ struct Options {
   double foot_pool = 0;
   /// The blended foot stage's gate: the outside quadrics' residual under this share of h.
   double foot_gate_residual = 0.05;
+  /// ... measured on the outside vertices at least this many h from the region (EvidenceOptions::
+  /// quadric_clearance; 0: all of them).
+  double foot_gate_clearance = 0;
   /// The blended foot stage reads the step's quadratic toe inwards of the threshold crossing and puts
   /// the foot where it meets the background (FootOptions::toe; not in the paper). Off until measured
   /// no worse on the whole randomized suite (docs/design.md, "The toe").
