@@ -211,7 +211,7 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
   std::vector<double> heights;
   std::vector<int> outside, near_outside, far_outside;
   std::vector<double> quadric_residuals;
-  std::vector<int> clear_outside;  // the outside vertices the quadric is fitted to
+  std::vector<int> clear_outside;  // the outside vertices beyond quadric_clearance of the region
   const std::vector<char> near_region =
       options.quadric_clearance > 0 ? grown_region(mesh, region, options.quadric_clearance * h) : std::vector<char>{};
   const double gap_bin = std::max(edge, radius / 1024);  // one edge (at most 1024 bins across the ball)
@@ -267,17 +267,18 @@ StepEvidence measure_step(const Mesh& mesh, const std::vector<SurfacePoint>& con
       continue;
     const Vec3 mean = plane.centroid, normal = plane.normal;
     const double residual = plane.residual();
-    if (near_region.empty()) {
-      quadric_residuals.push_back(std::min(residual, quadric_residual(mesh, outside, plane, h)));
-    } else {
+    // The roughness: over the outside vertices clear of the region (quadric_clearance), refitted.
+    const std::vector<int>* rough = &outside;
+    VertexPlaneFit rough_plane = plane;
+    if (!near_region.empty()) {
       clear_outside.clear();
       for (const int v : outside)
         if (!near_region[v]) clear_outside.push_back(v);
-      const VertexPlaneFit clear_plane = fit_vertex_plane(mesh, clear_outside);
-      if (static_cast<int>(clear_outside.size()) >= options.min_side_vertices && clear_plane.weight > 0)
-        quadric_residuals.push_back(
-            std::min(clear_plane.residual(), quadric_residual(mesh, clear_outside, clear_plane, h)));
+      rough = &clear_outside;
+      rough_plane = fit_vertex_plane(mesh, clear_outside);
     }
+    if (static_cast<int>(rough->size()) >= options.min_side_vertices && rough_plane.weight > 0)
+      quadric_residuals.push_back(std::min(rough_plane.residual(), quadric_residual(mesh, *rough, rough_plane, h)));
 
     heights.clear();
     for (const int v : ball)
