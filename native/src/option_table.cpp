@@ -189,7 +189,7 @@ const std::vector<Row>& rows() {
               "measured at its edge, where that disagrees with h (not in the paper)"),
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
-              "step at least 1.5 edges inside it, the outside planes' residual under 5% of h) (not in the paper)"),
+              "step at least 1.5 edges inside it, the outside quadrics' residual under foot_gate_residual of h) (not in the paper)"),
       number("foot_pool", &Options::foot_pool, "in [0, 5]", [](double x) { return x >= 0 && x <= 5; },
              "the blended foot stage: pool each snaxel's profile outwards with its neighbours' over this "
              "length of contour on each side, in h, before finding the foot (0: each alone) (not in the paper)"),

@@ -14,6 +14,7 @@ module or make-scan is missing: a suite that did not run is a failure.
 import glob
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -30,7 +31,14 @@ MODULE_DIR = os.environ.get("RELIEF_SNAKE_MODULE_DIR", BUILD)
 def _exit(code):
     sys.stdout.flush()
     sys.stderr.flush()
-    # os._exit: the same behaviour under `blender --python` and the bpy module (no teardown).
+    # os._exit: the same behaviour under `blender --python` and the bpy module (no teardown), so
+    # Blender's own session directory (bpy.app.tempdir) is removed here.
+    try:
+        import bpy
+        if bpy.app.tempdir and os.path.basename(os.path.normpath(bpy.app.tempdir)).startswith("blender_"):
+            shutil.rmtree(bpy.app.tempdir, ignore_errors=True)
+    except ImportError:
+        pass
     os._exit(code)
 
 
@@ -120,6 +128,7 @@ def main():
         _fail("%d test(s) skipped; a skipped test counts as a failure" % len(result.skipped))
     if not result.wasSuccessful() or result.testsRun == 0:
         _fail("%d failure(s), %d error(s)" % (len(result.failures), len(result.errors)))
+    shutil.rmtree(tmp, ignore_errors=True)  # kept on failure, for the scans it holds
     print("run_tests: OK")
     _exit(0)
 

@@ -1244,6 +1244,7 @@ def _plate():
     if "plate" not in _CFG:
         import json
         import os
+        import shutil
         import subprocess
         import tempfile
         build = os.environ.get("RELIEF_SNAKE_BUILD_DIR") or os.path.join(
@@ -1254,6 +1255,7 @@ def _plate():
         vertices, faces = plyio.read_ply(prefix + ".ply")
         with open(prefix + ".truth.json") as f:
             truth = json.load(f)
+        shutil.rmtree(os.path.dirname(prefix), ignore_errors=True)
         _CFG["plate"] = {"vertices": vertices, "faces": faces, "truth": truth}
     return _CFG["plate"]
 

@@ -5,6 +5,7 @@ as the segmentation, so the checks do not depend on the snake."""
 
 import math
 import os
+import shutil
 import tempfile
 import unittest
 
@@ -44,6 +45,7 @@ class ExtractionTestCase(unittest.TestCase):
         self.h = cfg()["truth"]["h"]
         bpy.context.scene.relief_snake.step_height = self.h
         self.tmp = tempfile.mkdtemp(prefix="relief-snake-extract-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
 
     def extract(self, **kw):
         return bpy.ops.mesh.relief_snake_extract(directory=self.tmp, **kw)

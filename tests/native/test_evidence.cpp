@@ -192,7 +192,7 @@ TEST(Evidence, TheQuadricResidualClearsTheToeLeftOutside) {
       EXPECT_LT(beyond, 0.5 * all);
     }
     if (inside == 0.5) {
-      EXPECT_GT(all, 0.05 * scan.h);    // the default gate (foot_gate_residual) shut ...
+      EXPECT_GT(all, 0.05 * scan.h);    // the gate of stop 37 (foot_gate_residual 0.05) shut ...
       EXPECT_LT(beyond, 0.05 * scan.h); // ... and open beyond the toe
     }
   }

@@ -316,10 +316,13 @@ TEST(SegmentFootGap, AContourUpABlendedSlopeIsDoubtful) {
     options.step_height = factor * scan.h;
     options.height_outline = height_outline;
     if (height_outline) {
-      // The outline as it was measured (before stop 37's toe and gate clearance): with them, the
-      // outlined contour ends 1.2 edges from the foot (height_outline stays off by default).
+      // The outline as it was measured (before stop 37's toe, gate clearance and pooled profiles):
+      // with the toe and the clearance the outlined contour ends 1.2 edges from the foot, with the
+      // pooled profiles too 1.25 (height_outline stays off by default).
       options.foot_toe = false;
       options.foot_gate_clearance = 0;
+      options.foot_pool = 0;
+      options.foot_gate_residual = 0.05;
     }
     return segment(mesh, picks.vertices, options);
   };
@@ -610,22 +613,45 @@ TEST(SegmentRefit, AStepMeasuredAgainAtItsOwnHeightKeepsTheContour) {
   scan.expect_accurate(outlined);
 }
 
-// Random scan 4185: a sharp rounded box under a dome on a sphere with striations, h typed x2.0. The
-// step found over the whole ball (x0.79 of h) reads the dome behind the edge and stays within the
-// refit's x1.3, and the contour at that h was a near miss called converged (1.14 edges from the
-// truth). The step at its edge reads x0.56 of h: the self-check fails on it, and the result segmented
-// again with h = that step is right and converged (with edge_step_refit=0 it stays doubtful).
+// Random scan 4185: a sharp rounded box under a dome on a sphere with striations, h typed x2.0. With
+// the foot stage's profiles unpooled (foot_pool=0, the default before stop 38), the step found over
+// the whole ball (x0.79 of h) reads the dome behind the edge and stays within the refit's x1.3, and
+// the contour at that h was a near miss called converged (1.14 edges from the truth). The step at
+// its edge reads x0.56 of h: the self-check fails on it, and the result segmented again with h = that
+// step is right and converged (with edge_step_refit=0 it stays doubtful).
 TEST(SegmentRefit, TheStepAtTheEdgeRefitsAnHTheDomeHid) {
   const RandomRun scan(4185);
   ASSERT_EQ(scan.random.draw.axes["detail"], "dome");
   ASSERT_GT(scan.random.draw.typed_factor, 1.9);
   EXPECT_TRUE(Options().edge_step_refit);
-  const Result result = scan.run(scan.options);
+  Options unpooled = scan.options;
+  unpooled.foot_pool = 0;
+  unpooled.foot_gate_residual = 0.05;
+  const Result result = scan.run(unpooled);
   ASSERT_EQ(result.status, Status::Converged) << result.message;
   EXPECT_TRUE(has_note(result, "the step at the contour's edge measured"));
   EXPECT_LT(result.parameters.step_height / scan.random.scan.h, 1.33);
   scan.expect_accurate(result);
-  scan.expect_doubtful_with([](Options& o) { o.edge_step_refit = false; }, "the step at the contour's edge is");
+  scan.expect_doubtful_with(
+      [](Options& o) {
+        o.foot_pool = 0;
+        o.foot_gate_residual = 0.05;
+        o.edge_step_refit = false;
+      },
+      "the step at the contour's edge is");
+  // With the pooled profiles (the default), the first contour's step reads x1.39 of h, not x1.55:
+  // the contour segmented again at that h is right, and the step at its edge (x0.78 of that h) is
+  // within the self-check's bound, so the edge's refit has nothing to do. Right and converged, with
+  // or without it.
+  const Result pooled = scan.run(scan.options);
+  ASSERT_EQ(pooled.status, Status::Converged) << pooled.message;
+  EXPECT_FALSE(has_note(pooled, "the step at the contour's edge measured"));
+  scan.expect_accurate(pooled);
+  Options pooled_no_edge = scan.options;
+  pooled_no_edge.edge_step_refit = false;
+  const Result pooled_alone = scan.run(pooled_no_edge);
+  EXPECT_EQ(pooled_alone.status, Status::Converged) << pooled_alone.message;
+  scan.expect_accurate(pooled_alone);
 }
 
 // An open contour's relief side decided from the surface can be wrong (the strips compared do not
@@ -654,14 +680,24 @@ TEST(SegmentOpen, ASideDecidedWronglyIsSegmentedFromTheOtherSide) {
   scan.expect_accurate(with_outline);
   // The side decided first, named by the user: the self-check says the result is not the relief.
   // (Since the foot test allows for its fit's error, a third h tried there stops at the iteration
-  // cap: the result is iteration_cap, with the same reason.)
+  // cap: the result is iteration_cap, with the same reason. With the pooled foot stage, the default
+  // since stop 38, the attempt kept says instead that the step could be measured along none of the
+  // contour: flagged either way, the foot stage as it was still gives the first reason.)
   Options named_left = scan.options;
   named_left.relief_side = ReliefSide::Left;
   const Result left = scan.run(named_left);
   EXPECT_NE(left.status, Status::Converged);
-  EXPECT_TRUE(std::any_of(left.reasons.begin(), left.reasons.end(),
+  EXPECT_TRUE(std::any_of(left.reasons.begin(), left.reasons.end(), [](const std::string& r) {
+    return r.find("runs along a step") != std::string::npos ||
+           r.find("the step could be measured along only") != std::string::npos;
+  })) << left.message;
+  named_left.foot_pool = 0;
+  named_left.foot_gate_residual = 0.05;
+  const Result left_unpooled = scan.run(named_left);
+  EXPECT_NE(left_unpooled.status, Status::Converged);
+  EXPECT_TRUE(std::any_of(left_unpooled.reasons.begin(), left_unpooled.reasons.end(),
                           [](const std::string& r) { return r.find("runs along a step") != std::string::npos; }))
-      << left.message;
+      << left_unpooled.message;
 }
 
 // Random scan 149: a band on a wavy, striated background, h and the side both left to the engine.

@@ -250,7 +250,11 @@ def main():
         t0 = time.time()
         with Display() as display:
             session = Session(display, args, name, args.out)
-            failure, result = session.run(args.timeout)
+            try:
+                failure, result = session.run(args.timeout)
+            finally:
+                # The session's private config and control files; its logs and screenshots are in args.out.
+                shutil.rmtree(session.tmp, ignore_errors=True)
         checks = (result or {}).get("checks", [])
         for c in checks:
             print("ui %-7s %s %s%s" % (name, "ok  " if c["ok"] else "FAIL", c["name"],
