@@ -187,6 +187,10 @@ const std::vector<Row>& rows() {
       boolean("edge_step_refit", &Options::edge_step_refit,
               "with the refit: a result that fails the self-check is segmented once more with h = the step "
               "measured at its edge, where that disagrees with h (not in the paper)"),
+      number("far_run_checked", &Options::far_run_checked, "in [0, 100]", [](double x) { return x >= 0 && x <= 100; },
+             "the self-check fails a contour with a stretch longer than this many h away from the step (over 5% "
+             "of it, h at least 3 average edges) even where the region-wide check found no background inside "
+             "(0: off) (not in the paper)"),
       boolean("foot_snap_blended", &Options::foot_snap_blended,
               "the foot stage only where the contour sits on a blended step over a clean background (half the "
               "step at least 1.5 edges inside it, the outside quadrics' residual under foot_gate_residual of h) (not in the paper)"),

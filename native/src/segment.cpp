@@ -442,6 +442,8 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
   // its h is on something else (texture, detail).
   SelfCheckOptions self_check;
   if (options.refit_step_height) self_check.max_step_ratio = std::max(1.5, options.refit_ratio * 1.15);
+  self_check.max_far_run_checked =
+      options.far_run_checked > 0 ? options.far_run_checked : std::numeric_limits<double>::infinity();
   // The contour-wise verdict without the far run, which the region-wide check replaces where it runs.
   SelfCheckOptions contour_wise = self_check;
   contour_wise.max_far_run = std::numeric_limits<double>::infinity();

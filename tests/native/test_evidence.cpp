@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "relief_snake/background.hpp"
 #include "relief_snake/evidence.hpp"
@@ -286,6 +287,28 @@ TEST(Evidence, JudgeNamesEachFailedCheck) {
   // background taken in.
   e.region_checked = true;
   EXPECT_TRUE(judge(e, 1.0, {}, &where).holds);
+  // ... unless the run is long (over max_far_run_checked, 2.5 h), over 5% of the profiles, on a mesh
+  // that resolves the step (h at least 3 average edges): on texture the fills can miss a bridge.
+  e.step.longest_far = 3.0;
+  e.step.far_share = 0.1;
+  e.step.average_edge = 0.2;  // 5 edges per h
+  c = judge(e, 1.0, {}, &where);
+  ASSERT_EQ(c.reasons.size(), 1u);
+  EXPECT_NE(c.reasons.front().find("3 h long"), std::string::npos) << c.reasons.front();
+  e.step.average_edge = 0.5;  // 2 edges per h: the profiles' 2-edge tolerance is a whole h
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.step.average_edge = 0.2;
+  e.step.far_share = 0.04;
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.step.far_share = 0.1;
+  e.step.longest_far = 2.4;
+  EXPECT_TRUE(judge(e, 1.0).holds);
+  e.step.longest_far = 3.0;
+  SelfCheckOptions off;
+  off.max_far_run_checked = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(judge(e, 1.0, off).holds);
+  e.step.average_edge = 0;
+  e.step.far_share = 0;
   e.region_checked = false;
   e.step.longest_far = 0;
   // Background inside the region: judged only when measured, above the depth and the edge floor.

@@ -160,6 +160,14 @@ struct SelfCheckOptions {
   /// background taken in (on the randomized suite the far run flagged right results on textured,
   /// coarse or rimmed reliefs, and no wrong one the region-wide check missed).
   double max_far_run = 1.5;
+  /// Where the region-wide check did run, a far run still counts when it is longer than this (in h),
+  /// the far profiles are over min_far_share_checked of them, and the mesh resolves the step (h at
+  /// least 3 average edges): on textured backgrounds the region-wide check's fills miss a bridge or a
+  /// lobe the contour's own profiles show, and on coarser meshes the profiles' 2-edge tolerance
+  /// flagged right results (randomized suite, docs/design.md, "The far run, resolved").
+  /// Infinity: off (as before stop 38).
+  double max_far_run_checked = 2.5;
+  double min_far_share_checked = 0.05;
   /// Deepest piece of background allowed inside the region (BackgroundInside::depth, in h; and
   /// at least ContourEvidence::background_depth_floor): a bridged concavity or a lobe holds a
   /// disk of background, a step's foot or a groove only a strip.

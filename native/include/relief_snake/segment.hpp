@@ -136,6 +136,10 @@ struct Options {
   /// wrong and converged 16 -> 16 and 20 -> 20 (seed 4185 right now, 2157 a near miss called converged
   /// where it was right and flagged); right results flagged 39 -> 40 and 44 -> 43 (docs/design.md).
   bool edge_step_refit = true;
+  /// The self-check's far run where the region-wide check ran too: a stretch of contour longer than
+  /// this many h away from the step, over 5% of the profiles, with h at least 3 average edges, fails
+  /// it (SelfCheckOptions::max_far_run_checked; 0: off, as before stop 38; not in the paper).
+  double far_run_checked = 2.5;
   /// Closed contours whose region takes in a piece of background (background_inside.hpp: a
   /// bridged concavity, a lobe): cut it out and refine again from the rest's outline, keeping the
   /// better evidence (not in the paper).
