@@ -464,10 +464,12 @@ SelfCheck judge(const ContourEvidence& all, double h, const SelfCheckOptions& op
     check.reasons.push_back("only " + percent(evidence.step_share) +
                             " of the contour runs along a step: it may have crossed into the relief or stopped "
                             "on detail or texture");
+  // Where the region-wide check ran, only a long, substantial run on a mesh that resolves the step.
   const bool resolved = evidence.average_edge > 0 && h >= 3 * evidence.average_edge;
-  const bool far_when_checked = all.region_checked && resolved && evidence.longest_far > options.max_far_run_checked * h &&
-                                evidence.far_share > options.min_far_share_checked;
-  if ((!all.region_checked && evidence.longest_far > options.max_far_run * h) || far_when_checked) {
+  const bool far = all.region_checked ? resolved && evidence.longest_far > options.max_far_run_checked * h &&
+                                            evidence.far_share > options.min_far_share_checked
+                                      : evidence.longest_far > options.max_far_run * h;
+  if (far) {
     std::string where;
     if (far_position)
       where = " around (" + number((*far_position)[0]) + ", " + number((*far_position)[1]) + ", " +

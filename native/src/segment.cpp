@@ -157,9 +157,9 @@ struct Attempt {
 // over at least 2 edges from a quarter to three quarters of its height (StepEvidence::
 // rise_width_median: a sharp or one-triangle step rises within one; on a coarser mesh one-edge bins
 // cannot tell them apart), and the background outside is clean: the residual of local quadrics
-// under foot_gate_residual of h (10%, with pooled profiles; 5% before stop 38) (StepEvidence::
-// background_quadric_residual; the planes' residual also counted a
-// sphere's or a cylinder's curvature as roughness). There the feature energy holds the snake part of
+// under foot_gate_residual of h (StepEvidence::background_quadric_residual; 10% with the pooled
+// profiles, 5% before stop 38; the planes' residual also counted a sphere's or a cylinder's
+// curvature as roughness). There the feature energy holds the snake part of
 // the way up the slope, and the foot stage brings it down to the foot; on sharp steps (already at
 // the foot), textured or noisy backgrounds (where the foot test fires on the texture) and coarse
 // meshes it only moved right contours off (randomized suite, docs/design.md).
@@ -542,8 +542,8 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
         FootOptions fo;
         fo.h = h_try;
         // Gated on a blended step, the foot test's own threshold (4 x the band's residual) copes with
-        // noise up to 5% of h (the gate until stop 38): the plain stage's noise limit is for sharp steps
-        // and texture. With the gate at 10% and the profiles pooled, measured as it is.
+        // noise up to 5% of h (the gate until stop 38; kept when pooling raised the gate to 10%, and
+        // measured so): the plain stage's noise limit is for sharp steps and texture.
         if (gated) fo.max_unclean_share = 0.5, fo.max_noise = 0.05, fo.toe = options.foot_toe;
         if (gated && options.foot_pool > 0) {
           // Snaxels within foot_pool h of each other along the contour, from its mean spacing.
