@@ -244,6 +244,14 @@ class Suite:
         # The step the engine measured at the result's edge (typed h or not).
         if isinstance(step_h.get("measured"), (int, float)) and true_h:
             row["h_measured_ratio"] = step_h["measured"] / true_h
+        # The same against the rim the relief's edge reaches (make-scan's edge_step_height): below h
+        # where a drop or an edge groove keeps the surface from reaching h. Absent from older scans.
+        rim = truth.get("edge_step_height")
+        if isinstance(rim, (int, float)) and rim > 0:
+            if isinstance(used_h, (int, float)):
+                row["h_rim_ratio"] = used_h / rim
+            if isinstance(step_h.get("measured"), (int, float)):
+                row["h_measured_rim_ratio"] = step_h["measured"] / rim
         row["flagged"] = not (proc["exit_code"] == 0 and row["status"] == "converged")
         sc = subprocess.run([str(self.make_scan), "score", str(case["truth_path"]), str(out), "--mesh",
                              str(case["mesh"])], capture_output=True, text=True)
@@ -318,6 +326,8 @@ def summarize(rows: list[dict]) -> dict:
     ratios = [r["h_ratio"] for r in rows if r.get("h_ratio")]
     first = [r["h_estimate_ratio"] for r in rows if r.get("h_estimate_ratio")]
     measured = [r["h_measured_ratio"] for r in rows if r.get("h_measured_ratio")]
+    rim_used = [r["h_rim_ratio"] for r in rows if r.get("h_rim_ratio")]
+    rim_measured = [r["h_measured_rim_ratio"] for r in rows if r.get("h_measured_rim_ratio")]
     accurate = [r for r in rows if r["accurate"]]
     wrong = [r for r in rows if not r["accurate"]]
     times = [r["wall_seconds"] for r in rows if r.get("wall_seconds") is not None]
@@ -348,6 +358,8 @@ def summarize(rows: list[dict]) -> dict:
         "h_within_075_133": (sum(0.75 <= x <= 1.33 for x in ratios) / n) if ratios else None,
         "h_estimate_within_075_133": (sum(0.75 <= x <= 1.33 for x in first) / n) if first else None,
         "h_measured_within_075_133": (sum(0.75 <= x <= 1.33 for x in measured) / n) if measured else None,
+        "h_used_within_rim": (sum(0.75 <= x <= 1.33 for x in rim_used) / n) if rim_used else None,
+        "h_measured_within_rim": (sum(0.75 <= x <= 1.33 for x in rim_measured) / n) if rim_measured else None,
     }
 
 
@@ -418,6 +430,11 @@ def write_report(config, variants, rows_by_variant, real_rows, real_note, machin
     line("the step measured at the result's edge (`step_height.measured`, typed h or not) within x0.75 … x1.33 "
          "(of all runs)", "≥ 95% with `--step-height auto`",
          lambda s: pct(s["h_measured_within_075_133"], 1) if s.get("h_measured_within_075_133") is not None else "—")
+    line("the step measured at the result's edge within x0.75 … x1.33 of the **rim** the relief's edge reaches "
+         "(make-scan's `edge_step_height`: h, or less where a drop or an edge groove keeps the surface below h)",
+         "", lambda s: pct(s["h_measured_within_rim"], 1) if s.get("h_measured_within_rim") is not None else "—")
+    line("h used within x0.75 … x1.33 of the rim", "",
+         lambda s: pct(s["h_used_within_rim"], 1) if s.get("h_used_within_rim") is not None else "—")
     line("`--step-height auto`: the first estimate (from the picks alone) within x0.75 … x1.33", "",
          lambda s: pct(s["h_estimate_within_075_133"], 1) if s.get("h_estimate_within_075_133") is not None else "—")
     line("CLI wall seconds, median / p95", "", lambda s: f"{fmt(s['wall_seconds_median'])} / {fmt(s['wall_seconds_p95'])}")

@@ -176,6 +176,40 @@ TEST(Synthetic, StepProfilesAlongTheNormal) {
   EXPECT_LE(hi, 0.8 * 1.2 + 1e-12);
 }
 
+// The rim a step measured at the edge can find: h for a plain step; below h where a drop or an edge
+// groove keeps the surface from reaching it; and the highest the generated vertices stand within
+// the profile's first rise (a fine disk, so vertices sample the profile densely).
+TEST(Synthetic, EdgeStepHeightIsTheRimTheVerticesReach) {
+  ScanSpec spec = make_spec(Shape::Disk);
+  spec.h = 0.8;
+  spec.triangles = 200000;
+  EXPECT_DOUBLE_EQ(edge_step_height(spec), 0.8);
+  spec.step = Step::Blended;
+  spec.blend_width = 0.5;
+  EXPECT_NEAR(edge_step_height(spec), 0.8, 1e-9);
+  spec.edge_groove = 0.5, spec.edge_groove_distance = 2, spec.groove_width = 0.3;  // clear of the rise
+  EXPECT_NEAR(edge_step_height(spec), 0.8, 1e-3 * 0.8);
+  struct Case { Step step; double blend; bool drop; double groove, at; double lo, hi; };
+  const Case cases[] = {{Step::Blended, 1.0, true, 0, 0, 0.45, 0.6},    // a blended rise into the drop
+                        {Step::Sharp, 0, true, 0, 0, 0.999, 1.0},       // sharp: the rim right at the edge
+                        {Step::Blended, 1.0, false, 0.6, 1.2, 0.5, 0.9}};  // the groove starts before the rise ends
+  for (const Case& c : cases) {
+    spec.step = c.step, spec.blend_width = c.blend > 0 ? c.blend : 0.5, spec.drop = c.drop;
+    spec.edge_groove = c.groove, spec.edge_groove_distance = c.at > 0 ? c.at : 1.5, spec.groove_width = 0.3;
+    const double rim = edge_step_height(spec);
+    EXPECT_GE(rim, c.lo * 0.8);
+    EXPECT_LE(rim, c.hi * 0.8);
+    const Scan s = generate(spec);
+    double highest = 0;  // the vertices' highest point short of 2 h in, where the profile starts again
+    for (std::size_t v = 0; v < s.n_vertices(); ++v) {
+      const double d = -sd_at(s, v);
+      if (d > 0 && d < (c.groove > 0 ? c.at : 2.0) * spec.h) highest = std::max(highest, s.V[3 * v + 2]);
+    }
+    EXPECT_LE(highest, rim + 1e-3 * spec.h);  // the profile is sampled every thousandth of h
+    EXPECT_GT(highest, rim - 0.02 * spec.h) << "the vertices should come close to the rim";
+  }
+}
+
 TEST(Synthetic, NoiseHasTheRequestedSigma) {
   ScanSpec spec = make_spec(Shape::Disk, Background::Plane, 100000);
   spec.noise = 0.1;

@@ -125,6 +125,16 @@ def test_auto_side_no_worse_than_measured(auto_side_sample):
     assert_no_worse(auto_side_sample, MEASURED_AUTO_SIDE_ACCURATE, MEASURED_AUTO_SIDE_SILENT)
 
 
+def test_the_step_is_also_scored_against_the_rim(auto_h_sample):
+    """Each run's measured step is scored against h and against the rim the relief's edge reaches
+    (make-scan's edge_step_height), which is never above h: the rim's ratio is never the smaller."""
+    measured = [r for r in auto_h_sample if r.get("h_measured_ratio")]
+    assert measured, "no run measured a step"
+    for r in measured:
+        assert "h_measured_rim_ratio" in r, r["case"]
+        assert r["h_measured_rim_ratio"] >= r["h_measured_ratio"] * (1 - 1e-12), r["case"]
+
+
 def test_seeds_take_ranges_and_single_seeds_in_one_list():
     sys.path.insert(0, str(REPO_ROOT))
     from bench.random_suite import parse_seeds

@@ -426,6 +426,7 @@ nlohmann::json random_truth_json(const RandomScan& random, const std::string& ba
   const IouFloor floor = one_edge_floor(scan);
   j["closed"] = random.picks.closed;
   j["true_step_height"] = scan.h;
+  j["edge_step_height"] = edge_step_height(random.draw.spec);
   j["typed_step_height"] = scan.h * random.draw.typed_factor;
   j["typed_factor"] = random.draw.typed_factor;
   j["h_over_average_edge"] = scan.h / scan.average_edge;

@@ -51,6 +51,17 @@ double smoothstep(double x) {
   return x * x * (3 - 2 * x);
 }
 
+// The edge profile at distance d inside the boundary: the step's rise (0 .. 1), the drop's top
+// (1, or falling to 0.3 within 1.5 h) and the edge groove's depth (in length units).
+double step_rise(const ScanSpec& spec, double d) {
+  return spec.step == Step::Sharp ? 1.0 : smoothstep(d / (spec.blend_width * spec.h));
+}
+double drop_top(const ScanSpec& spec, double d) { return spec.drop ? 1.0 - 0.7 * smoothstep(d / (1.5 * spec.h)) : 1.0; }
+double edge_groove_depth(const ScanSpec& spec, double d) {
+  const double off = (d - spec.edge_groove_distance * spec.h) / (spec.groove_width * spec.h);
+  return spec.edge_groove * spec.h * std::exp(-off * off);
+}
+
 // --- 2D signed distances (negative inside) -----------------------------------------------
 double sd_circle(double x, double y, double cx, double cy, double r) { return len2d(x - cx, y - cy) - r; }
 double sd_capsule(double x, double y, double ax, double ay, double bx, double by, double r) {
@@ -253,6 +264,25 @@ double texture_at(const ScanSpec& sp, double u, double v) {
 }
 
 }  // namespace
+
+double edge_step_height(const ScanSpec& spec) {
+  // The highest point of the profile up to where the step has risen and the profile then stops
+  // rising (a drop falls from there, an edge groove dips), in thousandths of h, at most 3 h in.
+  const auto profile = [&](double d) {
+    double height = spec.h * step_rise(spec, d) * drop_top(spec, d);
+    if (spec.edge_groove > 0) height -= edge_groove_depth(spec, d);
+    return height;
+  };
+  const int risen = spec.step == Step::Sharp ? 1 : std::max(1, static_cast<int>(std::ceil(1e3 * spec.blend_width)));
+  double rim = -std::numeric_limits<double>::infinity(), last = rim;
+  for (int k = 1; k <= 3000; ++k) {
+    const double height = profile(1e-3 * k * spec.h);
+    if (k > risen && height <= last) break;
+    rim = std::max(rim, height);
+    last = height;
+  }
+  return rim;
+}
 
 // --- enums -------------------------------------------------------------------------------
 Shape parse_shape(const std::string& n) {
@@ -691,9 +721,8 @@ Scan generate(const ScanSpec& spec) {
     double height = 0, rise = 0;
     if (sd < 0) {
       const double d = -sd;
-      rise = spec.step == Step::Sharp ? 1.0 : smoothstep(d / (spec.blend_width * h));
-      const double top = spec.drop ? 1.0 - 0.7 * smoothstep(d / (1.5 * h)) : 1.0;
-      height = h * rise * top;
+      rise = step_rise(spec, d);
+      height = h * rise * drop_top(spec, d);
       if (spec.detail > 0) {
         const double wave = 4 * h;
         height += spec.detail * h * smoothstep((d - spec.bump_inset * h) / h) * std::sin(2 * M_PI * u / wave) *
@@ -706,10 +735,7 @@ Scan generate(const ScanSpec& spec) {
         const double off = std::remainder(across, spec.groove_spacing * h) / (spec.groove_width * h);
         height -= spec.grooves * h * std::exp(-off * off) * smoothstep((d - 0.5 * h) / (0.5 * h));
       }
-      if (spec.edge_groove > 0) {
-        const double off = (d - spec.edge_groove_distance * h) / (spec.groove_width * h);
-        height -= spec.edge_groove * h * std::exp(-off * off);
-      }
+      if (spec.edge_groove > 0) height -= edge_groove_depth(spec, d);
     }
     s.relief_height[k] = height;
     if (spec.texture != Texture::None) {

@@ -203,6 +203,13 @@ struct Scan {
 /// Generates a scan. Throws Error on bad parameters. Deterministic for a spec.
 Scan generate(const ScanSpec& spec);
 
+/// The height the relief stands at just inside its edge: where the edge profile alone (the step's
+/// rise, the drop, the edge groove; not the dome, bumps or grooves further in) first stops rising.
+/// It is h unless a drop or an edge groove keeps the rim below h: a blended step into a drop tops
+/// out near 0.5 h, and a blended step whose edge groove starts before it has risen leaves a rim
+/// lower than the top beyond the groove. A step measured at the contour's edge reads the rim.
+double edge_step_height(const ScanSpec& spec);
+
 // --- the random family -----------------------------------------------------------------
 
 /// One draw of the random family: every axis drawn from seeded distributions (docs in
