@@ -73,6 +73,10 @@ class Session:
         # A private user config: installing the zip must not touch the user's Blender.
         self.env.update(BLENDER_USER_CONFIG=os.path.join(self.tmp, "config"),
                         BLENDER_USER_SCRIPTS=os.path.join(self.tmp, "scripts"), HOME=self.tmp)
+        # Blender's session directory (blender_XXXXXX) too: the harness ends Blender with a signal,
+        # which skips Blender's own clean-up, so it goes where the session's clean-up removes it.
+        os.makedirs(os.path.join(self.tmp, "tmp"))
+        self.env.update(TMPDIR=os.path.join(self.tmp, "tmp"), TMP=os.path.join(self.tmp, "tmp"))
         self.window = None
         self.log = []
 
