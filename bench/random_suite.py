@@ -328,6 +328,9 @@ def summarize(rows: list[dict]) -> dict:
     measured = [r["h_measured_ratio"] for r in rows if r.get("h_measured_ratio")]
     rim_used = [r["h_rim_ratio"] for r in rows if r.get("h_rim_ratio")]
     rim_measured = [r["h_measured_rim_ratio"] for r in rows if r.get("h_measured_rim_ratio")]
+
+    def in_range(xs):  # the share of all runs with a ratio in x0.75 … x1.33 (None: no run has one)
+        return sum(0.75 <= x <= 1.33 for x in xs) / n if xs else None
     accurate = [r for r in rows if r["accurate"]]
     wrong = [r for r in rows if not r["accurate"]]
     times = [r["wall_seconds"] for r in rows if r.get("wall_seconds") is not None]
@@ -355,11 +358,11 @@ def summarize(rows: list[dict]) -> dict:
         "outcomes": outcomes,
         "wrong_by_reason": reasons(wrong),
         # Over all runs: a run that ends without an h (refused) counts as out of range.
-        "h_within_075_133": (sum(0.75 <= x <= 1.33 for x in ratios) / n) if ratios else None,
-        "h_estimate_within_075_133": (sum(0.75 <= x <= 1.33 for x in first) / n) if first else None,
-        "h_measured_within_075_133": (sum(0.75 <= x <= 1.33 for x in measured) / n) if measured else None,
-        "h_used_within_rim": (sum(0.75 <= x <= 1.33 for x in rim_used) / n) if rim_used else None,
-        "h_measured_within_rim": (sum(0.75 <= x <= 1.33 for x in rim_measured) / n) if rim_measured else None,
+        "h_within_075_133": in_range(ratios),
+        "h_estimate_within_075_133": in_range(first),
+        "h_measured_within_075_133": in_range(measured),
+        "h_used_within_rim": in_range(rim_used),
+        "h_measured_within_rim": in_range(rim_measured),
     }
 
 
@@ -412,6 +415,9 @@ def write_report(config, variants, rows_by_variant, real_rows, real_note, machin
     L.append("")
     rows = []
 
+    def share(key):  # a summary's share as a percentage, "—" where no run had the value
+        return lambda s: pct(s[key], 1) if s.get(key) is not None else "—"
+
     def line(label, target, fn):
         rows.append([label, target] + [fn(summaries[v]) for v in names])
 
@@ -426,17 +432,17 @@ def write_report(config, variants, rows_by_variant, real_rows, real_note, machin
     line("accurate and converged", "", lambda s: f"{s['accurate_and_converged']} ({pct(s['accurate_and_converged'], s['runs'])})")
     line("h used (typed, or with `--step-height auto` the estimate after the refit along the contour) within "
          "x0.75 … x1.33 of the true step (of all runs: one without a result counts as out of range)", "",
-         lambda s: pct(s["h_within_075_133"], 1) if s["h_within_075_133"] is not None else "—")
+         share("h_within_075_133"))
     line("the step measured at the result's edge (`step_height.measured`, typed h or not) within x0.75 … x1.33 "
          "(of all runs)", "≥ 95% with `--step-height auto`",
-         lambda s: pct(s["h_measured_within_075_133"], 1) if s.get("h_measured_within_075_133") is not None else "—")
+         share("h_measured_within_075_133"))
     line("the step measured at the result's edge within x0.75 … x1.33 of the **rim** the relief's edge reaches "
          "(make-scan's `edge_step_height`: h, or less where a drop or an edge groove keeps the surface below h)",
-         "", lambda s: pct(s["h_measured_within_rim"], 1) if s.get("h_measured_within_rim") is not None else "—")
+         "", share("h_measured_within_rim"))
     line("h used within x0.75 … x1.33 of the rim", "",
-         lambda s: pct(s["h_used_within_rim"], 1) if s.get("h_used_within_rim") is not None else "—")
+         share("h_used_within_rim"))
     line("`--step-height auto`: the first estimate (from the picks alone) within x0.75 … x1.33", "",
-         lambda s: pct(s["h_estimate_within_075_133"], 1) if s.get("h_estimate_within_075_133") is not None else "—")
+         share("h_estimate_within_075_133"))
     line("CLI wall seconds, median / p95", "", lambda s: f"{fmt(s['wall_seconds_median'])} / {fmt(s['wall_seconds_p95'])}")
     line("engine seconds, median / p95", "", lambda s: f"{fmt(s['engine_seconds_median'])} / {fmt(s['engine_seconds_p95'])}")
     line("outcomes", "", lambda s: ", ".join(f"{k} {n}" for k, n in sorted(s["outcomes"].items())))
