@@ -214,6 +214,10 @@ const std::vector<Row>& rows() {
              [](double x) { return x >= 0 && x <= 3; },
              "the region-wide check's background fills: the inner band of their 3 h ring fitted softly, in h "
              "(3: the whole ring) (not in the paper)"),
+      number("region_check_textured_smoothing", &Options::region_check_textured_smoothing, "in [0, 5]",
+             [](double x) { return x >= 0 && x <= 5; },
+             "the region-wide check: where the ring's quadric sees a deep piece the fills do not, fill again "
+             "softly over the whole ring with this smoothing length, in h (0: no second opinion) (not in the paper)"),
       boolean("height_outline", &Options::height_outline,
               "closed contours: when no refinement passes the self-check, refine once more from just outside "
               "what stands half a step above the background filled in under the region (not in the paper)"),

@@ -467,8 +467,10 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
     fill.smoothing_band = options.region_check_band;
     const BackgroundInsideCheck* cached = cache_->background_inside.get();
     if (!cached || cached->fill_options().smoothing != fill.smoothing ||
-        cached->fill_options().smoothing_band != fill.smoothing_band)
-      cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh, fill);
+        cached->fill_options().smoothing_band != fill.smoothing_band ||
+        cached->textured_smoothing() != options.region_check_textured_smoothing)
+      cache_->background_inside =
+          std::make_unique<BackgroundInsideCheck>(mesh, fill, options.region_check_textured_smoothing);
     a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / a.h;
     BackgroundInside inside = cache_->background_inside->measure(
         a.region, a.h, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * a.h);

@@ -534,6 +534,26 @@ TEST(SegmentCheck, AWholeRingFitSeesTheBridgedCOnStriations) {
   EXPECT_GT(check_value(result, "background_depth"), 0.75);
 }
 
+// Random scan 5018: a C on a saddle with striations 0.26 h, a one-triangle step 2.2 edges high, h
+// typed x0.55 (refit to the step). The contour bridges the C's gap and takes in its whole inside
+// (IoU 0.74). The ring quadric sees that piece (9.6 h deep), but the fill held to the textured ring
+// sags under the wide region and reads the inside 0.4 h above the background (0.8 h deep): the
+// result was wrong and converged. The second opinion, fitted softly over the whole ring, sees it.
+TEST(SegmentCheck, ASoftFillIsASecondOpinionOnABridgedCOnStriations) {
+  const RandomRun scan(5018);
+  ASSERT_EQ(scan.random.draw.axes["texture"], "striations");
+  ASSERT_EQ(scan.random.draw.axes["shape"], "c");
+  Options without = scan.options;
+  without.region_check_textured_smoothing = 0;
+  const Result held = scan.run(without);
+  Options with = scan.options;
+  with.region_check_textured_smoothing = 1.5;
+  const Result result = scan.run(with);
+  EXPECT_NE(result.status, Status::Converged) << result.message;
+  EXPECT_GT(check_value(result, "background_depth"), 2 * check_value(held, "background_depth"));
+  EXPECT_GT(check_value(result, "background_area"), 100.0);
+}
+
 // Random scan 3126: a C on a plane, a blended step 0.7 h wide, noise 0.014 h, h typed x0.96. The
 // foot stage reads the background it fitted outside each snaxel down to the snaxel; read there, a
 // quadratic fit errs by several times its residual, and with a threshold of 4 residuals runs of

@@ -69,19 +69,30 @@ bool deep_background_piece(double depth, double area, double limit);
 /// follows a vase the height field misses): the shallower depth and its area are kept, with the height
 /// field's pieces and deepest vertex. measured is false when the screen saw nothing deep; checked is
 /// true whenever the screen or a fill could measure the region.
+///
+/// A second opinion where the screen saw a deep piece and the fill did not (textured_smoothing > 0):
+/// a fill held to a textured ring continues the texture's slopes under a wide region and can sag or
+/// lift by half a step over a bridged C's inside (random scan 5018: the inside read 0.4 h above it).
+/// The same two fills again, fitted softly over the whole ring with that longer smoothing length (as
+/// relief_mask.hpp's fill is); a piece deep under both is kept as above.
 class BackgroundInsideCheck {
  public:
   /// fill: the fills' common options (their smoothing and soft band); each fill sets its own
   /// Laplacian and model on top.
-  explicit BackgroundInsideCheck(const Mesh& mesh, const BackgroundOptions& fill = {}) : mesh_(mesh), fill_(fill) {}
+  /// textured_smoothing: the second opinion's smoothing length, in h (0: none).
+  explicit BackgroundInsideCheck(const Mesh& mesh, const BackgroundOptions& fill = {}, double textured_smoothing = 0)
+      : mesh_(mesh), fill_(fill), textured_smoothing_(textured_smoothing) {}
   BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit);
   const BackgroundOptions& fill_options() const { return fill_; }
+  double textured_smoothing() const { return textured_smoothing_; }
 
  private:
   const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
   const Mesh& mesh_;
   BackgroundOptions fill_;
+  double textured_smoothing_ = 0;
   std::unique_ptr<BackgroundSolver> cotangent_, uniform_, surface_;
+  std::unique_ptr<BackgroundSolver> textured_cotangent_, textured_uniform_, textured_surface_;
 };
 
 }  // namespace relief_snake

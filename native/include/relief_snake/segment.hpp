@@ -117,6 +117,10 @@ struct Options {
   double region_check_smoothing = 0.5;
   /// ... over this inner band of the ring, in h (BackgroundOptions::smoothing_band; the ring is 3 h).
   double region_check_band = 1;
+  /// ... and where their ring quadric saw a deep piece the fill did not, a second opinion: the fills
+  /// again, fitted softly over the whole ring with this smoothing length, in h (BackgroundInsideCheck;
+  /// 0: none). A textured ring tilts a fill held to it under a wide region (not in the paper).
+  double region_check_textured_smoothing = 0;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
   /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
