@@ -117,20 +117,19 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   double seconds = screen.seconds;
   // The height-field fill (uniform weights where the cotangent ones are singular), confirmed where deep
   // by the fill of the positions: the shallower depth and its area kept.
-  auto filled = [&](const BackgroundOptions& options, std::unique_ptr<BackgroundSolver>& cotangent,
-                    std::unique_ptr<BackgroundSolver>& uniform, std::unique_ptr<BackgroundSolver>& surface) {
-    BackgroundInside b = measure_background_inside(mesh_, region, h, step, &solver(cotangent, options));
+  auto filled = [&](const BackgroundOptions& options, Fills& fills) {
+    BackgroundInside b = measure_background_inside(mesh_, region, h, step, &solver(fills.cotangent, options));
     seconds += b.seconds;
     if (!b.measured) {  // cotangent weights of a sharp wall's projection can be singular
       BackgroundOptions with_uniform = options;
       with_uniform.laplacian = BackgroundLaplacian::Uniform;
-      b = measure_background_inside(mesh_, region, h, step, &solver(uniform, with_uniform));
+      b = measure_background_inside(mesh_, region, h, step, &solver(fills.uniform, with_uniform));
       seconds += b.seconds;
     }
     if (deep(b)) {
       BackgroundOptions positions = options;
       positions.model = BackgroundModel::Surface;
-      const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(surface, positions));
+      const BackgroundInside second = measure_background_inside(mesh_, region, h, step, &solver(fills.surface, positions));
       seconds += second.seconds;
       if (second.measured && second.depth < b.depth) b.depth = second.depth, b.area = second.area;
     }
@@ -138,12 +137,12 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   };
   BackgroundInside out;
   if (!screen.measured || deep(screen)) {
-    out = filled(fill_, cotangent_, uniform_, surface_);
+    out = filled(fill_, fills_);
     if (textured_smoothing_ > 0 && deep(screen) && !deep(out)) {
       BackgroundOptions soft = fill_;
       soft.smoothing = textured_smoothing_;
       soft.smoothing_band = soft.ring_width;
-      BackgroundInside again = filled(soft, textured_cotangent_, textured_uniform_, textured_surface_);
+      BackgroundInside again = filled(soft, textured_fills_);
       if (deep(again)) out = std::move(again);
     }
   }

@@ -87,12 +87,16 @@ class BackgroundInsideCheck {
   double textured_smoothing() const { return textured_smoothing_; }
 
  private:
+  // One opinion's solvers, each built when first needed: the height field with cotangent and with
+  // uniform weights, and the positions' fill.
+  struct Fills {
+    std::unique_ptr<BackgroundSolver> cotangent, uniform, surface;
+  };
   const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
   const Mesh& mesh_;
   BackgroundOptions fill_;
   double textured_smoothing_ = 0;
-  std::unique_ptr<BackgroundSolver> cotangent_, uniform_, surface_;
-  std::unique_ptr<BackgroundSolver> textured_cotangent_, textured_uniform_, textured_surface_;
+  Fills fills_, textured_fills_;
 };
 
 }  // namespace relief_snake
