@@ -107,7 +107,8 @@ const BackgroundSolver& BackgroundInsideCheck::solver(std::unique_ptr<Background
   return *slot;
 }
 
-BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region, double h, double step, double limit) {
+BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region, double h, double step, double limit,
+                                                double roughness) {
   auto deep = [&](const BackgroundInside& b) {
     return b.measured && b.deepest_vertex >= 0 && deep_background_piece(b.depth, b.area, limit);
   };
@@ -138,9 +139,10 @@ BackgroundInside BackgroundInsideCheck::measure(const std::vector<char>& region,
   BackgroundInside out;
   if (!screen.measured || deep(screen)) {
     out = filled(fill_, fills_);
-    if (textured_smoothing_ > 0 && deep(screen) && !deep(out)) {
+    const bool textured = roughness >= textured_.min_roughness * step;
+    if (textured_.smoothing > 0 && textured && deep(screen) && !deep(out)) {
       BackgroundOptions soft = fill_;
-      soft.smoothing = textured_smoothing_;
+      soft.smoothing = textured_.smoothing;
       soft.smoothing_band = soft.ring_width;
       BackgroundInside again = filled(soft, textured_fills_);
       if (deep(again)) out = std::move(again);

@@ -218,6 +218,10 @@ const std::vector<Row>& rows() {
              [](double x) { return x >= 0 && x <= 5; },
              "the region-wide check: where the ring's quadric sees a deep piece the fills do not, fill again "
              "softly over the whole ring with this smoothing length, in h (0: no second opinion) (not in the paper)"),
+      number("region_check_textured_roughness", &Options::region_check_textured_roughness, "in [0, 1]",
+             [](double x) { return x >= 0 && x <= 1; },
+             "the region-wide check's second opinion: only where the background's roughness outside the "
+             "contour is at least this share of the step (a textured ring) (not in the paper)"),
       boolean("height_outline", &Options::height_outline,
               "closed contours: when no refinement passes the self-check, refine once more from just outside "
               "what stands half a step above the background filled in under the region (not in the paper)"),

@@ -465,15 +465,17 @@ Result Segmenter::segment_one_side(const std::vector<std::int64_t>& picks, const
     BackgroundOptions fill;
     fill.smoothing = options.region_check_smoothing;
     fill.smoothing_band = options.region_check_band;
+    TexturedOpinion textured;
+    textured.smoothing = options.region_check_textured_smoothing;
+    textured.min_roughness = options.region_check_textured_roughness;
     const BackgroundInsideCheck* cached = cache_->background_inside.get();
     if (!cached || cached->fill_options().smoothing != fill.smoothing ||
-        cached->fill_options().smoothing_band != fill.smoothing_band ||
-        cached->textured_smoothing() != options.region_check_textured_smoothing)
-      cache_->background_inside =
-          std::make_unique<BackgroundInsideCheck>(mesh, fill, options.region_check_textured_smoothing);
+        cached->fill_options().smoothing_band != fill.smoothing_band || !(cached->textured_opinion() == textured))
+      cache_->background_inside = std::make_unique<BackgroundInsideCheck>(mesh, fill, textured);
     a.evidence.background_depth_floor = 2 * mesh.average_edge_length() / a.h;
     BackgroundInside inside = cache_->background_inside->measure(
-        a.region, a.h, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * a.h);
+        a.region, a.h, a.evidence.step.step_height, background_depth_limit(a.evidence, self_check) * a.h,
+        a.evidence.step.background_quadric_residual);
     background_seconds += inside.seconds;
     a.evidence.region_checked = inside.checked;
     a.evidence.background_measured = inside.measured && inside.deepest_vertex >= 0;

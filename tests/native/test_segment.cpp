@@ -554,6 +554,25 @@ TEST(SegmentCheck, ASoftFillIsASecondOpinionOnABridgedCOnStriations) {
   EXPECT_GT(check_value(result, "background_area"), 100.0);
 }
 
+// Random scan 3081: a duck on waves with no texture, an edge groove, h typed x1.11; its contour is
+// right. The ring quadric does not follow the waves and sees a deep piece the exact fill does not.
+// The soft fill, asked anyway, loses the waves' curvature too: the region was doubtful and the
+// attempts after it ended wrong. The second opinion is for textured rings: here the ring's roughness
+// is about a hundredth of the step, and the result stays right and converged.
+TEST(SegmentCheck, TheSecondOpinionIsNotAskedOnASmoothRing) {
+  const RandomRun scan(3081, RandomRun::AsStored{});
+  ASSERT_EQ(scan.random.draw.axes["texture"], "none");
+  Options gated = scan.options;
+  gated.region_check_textured_smoothing = 1.5;
+  const Result result = scan.run(gated);
+  ASSERT_EQ(result.status, Status::Converged) << result.message;
+  scan.expect_accurate(result);
+  EXPECT_LT(check_value(result, "background_quadric_residual"), 0.1 * check_value(result, "step_height"));
+  Options asked_anyway = gated;
+  asked_anyway.region_check_textured_roughness = 0;
+  EXPECT_NE(scan.run(asked_anyway).status, Status::Converged);
+}
+
 // Random scan 3126: a C on a plane, a blended step 0.7 h wide, noise 0.014 h, h typed x0.96. The
 // foot stage reads the background it fitted outside each snaxel down to the snaxel; read there, a
 // quadratic fit errs by several times its residual, and with a threshold of 4 residuals runs of

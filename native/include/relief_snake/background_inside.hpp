@@ -70,21 +70,31 @@ bool deep_background_piece(double depth, double area, double limit);
 /// field's pieces and deepest vertex. measured is false when the screen saw nothing deep; checked is
 /// true whenever the screen or a fill could measure the region.
 ///
-/// A second opinion where the screen saw a deep piece and the fill did not (textured_smoothing > 0):
-/// a fill held to a textured ring continues the texture's slopes under a wide region and can sag or
-/// lift by half a step over a bridged C's inside (random scan 5018: the inside read 0.4 h above it).
-/// The same two fills again, fitted softly over the whole ring with that longer smoothing length (as
-/// relief_mask.hpp's fill is); a piece deep under both is kept as above.
+/// A second opinion where the screen saw a deep piece and the fill did not, on a textured ring
+/// (TexturedOpinion): a fill held to a textured ring continues the texture's slopes under a wide
+/// region and can sag or lift by half a step over a bridged C's inside (random scan 5018: the inside
+/// read 0.4 h above it). The same two fills again, fitted softly over the whole ring with a longer
+/// smoothing length (as relief_mask.hpp's fill is); a piece deep under both is kept as above. On a
+/// smooth ring the soft fill has no texture to ride over and only loses the curvature the exact fill
+/// follows (a vase, waves, an edge groove): there it is not asked.
+struct TexturedOpinion {
+  double smoothing = 0;  ///< the soft fill's smoothing length, in h (0: no second opinion)
+  /// Asked only where the ring's roughness (its residual from local quadrics, as the step evidence
+  /// measures it: StepEvidence::background_quadric_residual) is at least this share of the step.
+  double min_roughness = 0.1;
+  bool operator==(const TexturedOpinion& o) const { return smoothing == o.smoothing && min_roughness == o.min_roughness; }
+};
+
 class BackgroundInsideCheck {
  public:
   /// fill: the fills' common options (their smoothing and soft band); each fill sets its own
   /// Laplacian and model on top.
-  /// textured_smoothing: the second opinion's smoothing length, in h (0: none).
-  explicit BackgroundInsideCheck(const Mesh& mesh, const BackgroundOptions& fill = {}, double textured_smoothing = 0)
-      : mesh_(mesh), fill_(fill), textured_smoothing_(textured_smoothing) {}
-  BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit);
+  explicit BackgroundInsideCheck(const Mesh& mesh, const BackgroundOptions& fill = {}, const TexturedOpinion& textured = {})
+      : mesh_(mesh), fill_(fill), textured_(textured) {}
+  /// roughness: the ring's roughness, in mesh units (for the textured opinion; 0: smooth).
+  BackgroundInside measure(const std::vector<char>& region, double h, double step, double limit, double roughness = 0);
   const BackgroundOptions& fill_options() const { return fill_; }
-  double textured_smoothing() const { return textured_smoothing_; }
+  const TexturedOpinion& textured_opinion() const { return textured_; }
 
  private:
   // One opinion's solvers, each built when first needed: the height field with cotangent and with
@@ -95,7 +105,7 @@ class BackgroundInsideCheck {
   const BackgroundSolver& solver(std::unique_ptr<BackgroundSolver>& slot, const BackgroundOptions& options);
   const Mesh& mesh_;
   BackgroundOptions fill_;
-  double textured_smoothing_ = 0;
+  TexturedOpinion textured_;
   Fills fills_, textured_fills_;
 };
 

@@ -121,6 +121,10 @@ struct Options {
   /// again, fitted softly over the whole ring with this smoothing length, in h (BackgroundInsideCheck;
   /// 0: none). A textured ring tilts a fill held to it under a wide region (not in the paper).
   double region_check_textured_smoothing = 0;
+  /// ... asked only where the ring's roughness (the step evidence's residual from local quadrics
+  /// outside the contour) is at least this share of the step found: a textured ring, not a smooth
+  /// one whose curvature the soft fill would lose (TexturedOpinion::min_roughness).
+  double region_check_textured_roughness = 0.1;
   /// Move snaxels resting on a sharp step's tall wall down to its foot (foot.hpp, settle_down_walls).
   bool wall_foot = true;
   /// The self-check's coarse overlap: a refined region that strays from the coarse contour's is
