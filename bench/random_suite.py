@@ -51,7 +51,8 @@ from bench.run import EXIT_DOUBTFUL, REPO, machine_info, run_engine, runaway_lim
 OLD_DEFAULTS = ("--w-int 0.25 --max-iterations 3000 tau=0.2 epsilon=0.2 q_samples=5 exact_q=0 max_turn_degrees=160 "
                 "lock_interval=10 feature_contrast=0.25 scale_feature_with_spacing=1 convex_barrier=0 remove_loops=1 "
                 "foot_snap=0 refine_levels=1 nearest_resampling=1 neighbourhood=sphere plane_fit=vertex_areas "
-                "planarity_one_ring=1 refit_step_height=0 repair_background=0 foot_snap_blended=0 wall_foot=0 retry_estimate=off")
+                "planarity_one_ring=1 refit_step_height=0 repair_background=0 foot_snap_blended=0 wall_foot=0 retry_estimate=off "
+                "region_check_textured_smoothing=0")
 # auto-side: the CLI's own defaults, h and an open contour's relief side both left to the engine (the
 # other variants give the truth's side, as a user who names it would; on closed scans it is auto-h).
 BUILTIN_VARIANTS = {"defaults": "", "paper": f"--w-int {PAPER_W_INT} " + " ".join(PAPER),
