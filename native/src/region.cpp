@@ -11,6 +11,9 @@ namespace relief_snake {
 namespace {
 
 enum : char { kUnknown = 0, kLeft = 1, kRight = 2 };
+// A part the cuts close off whose minority side holds at most this share of its majority's seeds is
+// the majority's side (relief_region): a trace gap joins two sides with about as many seeds each.
+constexpr double kMinorityShare = 0.1;
 
 int corner_of(const Mesh& mesh, int f, int v) {
   for (int k = 0; k < 3; ++k)
@@ -190,6 +193,52 @@ std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint
       if (label[*w] != kUnknown || cutter.is_cut(u, *w)) continue;
       label[*w] = label[u];
       queue.push_back(*w);
+    }
+  }
+  // A seed on the wrong side (votes of a contour that passes a vertex several times can net to the
+  // other side's sign) wins a wedge of the far side in that flood: the fronts between it and its
+  // neighbours run outwards to the mesh's end (random scan 6191: 764 background vertices, out to 83
+  // edges, with the contour within an edge of the truth). A part of the mesh the cuts close off on
+  // its own whose seeds are almost all on one side is that side, but for single seeds that won
+  // nothing beyond themselves; where the sides are mixed, a trace gap joined them, and the flood's
+  // labels stand.
+  std::vector<int> part(nv, -1), members, patch(nv, -1), patch_members;
+  for (int start = 0; start < nv; ++start) {
+    if (part[start] >= 0) continue;
+    members.assign(1, start);
+    part[start] = start;
+    int left_seeds = 0, right_seeds = 0;
+    for (std::size_t head = 0; head < members.size(); ++head) {
+      const int u = members[head];
+      left_seeds += cutter.vote[u] > 0 ? 1 : 0;
+      right_seeds += cutter.vote[u] < 0 ? 1 : 0;
+      for (const int* w = mesh.neighbors_begin(u); w != mesh.neighbors_end(u); ++w) {
+        if (part[*w] >= 0 || cutter.is_cut(u, *w)) continue;
+        part[*w] = start;
+        members.push_back(*w);
+      }
+    }
+    const int majority = std::max(left_seeds, right_seeds), minority = std::min(left_seeds, right_seeds);
+    if (minority == 0 || kMinorityShare * majority < minority) continue;
+    // The minority's patches (connected, same label) that grew past their own seeds. A seed that
+    // won only itself is a local mislabel at the contour and stays as the flood left it.
+    const char side = left_seeds > right_seeds ? kLeft : kRight;
+    for (const int u : members) {
+      if (label[u] == side || label[u] == kUnknown || patch[u] >= 0) continue;
+      patch_members.assign(1, u);
+      patch[u] = u;
+      std::size_t seeds = 0;
+      for (std::size_t head = 0; head < patch_members.size(); ++head) {
+        const int x = patch_members[head];
+        seeds += cutter.vote[x] != 0 ? 1 : 0;
+        for (const int* w = mesh.neighbors_begin(x); w != mesh.neighbors_end(x); ++w) {
+          if (patch[*w] >= 0 || label[*w] != label[u] || cutter.is_cut(x, *w)) continue;
+          patch[*w] = u;
+          patch_members.push_back(*w);
+        }
+      }
+      if (patch_members.size() > seeds)
+        for (const int x : patch_members) label[x] = side;
     }
   }
   const char inside = inside_left ? kLeft : kRight;

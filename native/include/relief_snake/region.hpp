@@ -17,8 +17,12 @@ namespace relief_snake {
 /// cut and its endpoints are seeded with their side, read from the mesh orientation
 /// (entering face f across the edge opposite corner k, corner k+1 is on the left).
 /// A competitive breadth-first flood from all seeds over uncut edges then labels
-/// the rest, so a missed crossing only mislabels locally. Vertices no seed reaches
-/// (other components) are not relief. Open contours should end on the mesh boundary.
+/// the rest, so a missed crossing only mislabels locally. A part of the mesh the cuts
+/// close off whose seeds are all but a few on one side (at most a tenth as many on the
+/// other) is then that side, but for a stray seed that won only itself: a stray seed (a
+/// contour through a vertex nets its votes to the wrong sign) would otherwise win a wedge
+/// of the flood running out to the mesh's end. Vertices no seed reaches (other components) are not relief. Open contours
+/// should end on the mesh boundary.
 std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint>& contour, bool closed,
                                 bool inside_left);
 
