@@ -195,9 +195,9 @@ std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint
       queue.push_back(*w);
     }
   }
-  // A seed on the wrong side (votes of a contour that passes a vertex several times can net to the
-  // other side's sign) wins a wedge of the far side in that flood: the fronts between it and its
-  // neighbours run outwards to the mesh's end (random scan 6191: 764 background vertices, out to 83
+  // A seed on the wrong side (a hairpin of the traced contour that circles a vertex, its fan crossed
+  // twice, votes the far side to the other side's sign) wins a wedge of the far side in that flood:
+  // the fronts between it and its neighbours run outwards to the mesh's end (random scan 6191: 764 background vertices, out to 83
   // edges, with the contour within an edge of the truth). A part of the mesh the cuts close off on
   // its own whose seeds are almost all on one side is that side, but for single seeds that won
   // nothing beyond themselves; where the sides are mixed, a trace gap joined them, and the flood's

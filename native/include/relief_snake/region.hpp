@@ -20,9 +20,9 @@ namespace relief_snake {
 /// the rest, so a missed crossing only mislabels locally. A part of the mesh the cuts
 /// close off whose seeds are all but a few on one side (at most a tenth as many on the
 /// other) is then that side, but for a stray seed that won only itself: a stray seed (a
-/// contour through a vertex nets its votes to the wrong sign) would otherwise win a wedge
-/// of the flood running out to the mesh's end. Vertices no seed reaches (other components) are not relief. Open contours
-/// should end on the mesh boundary.
+/// hairpin of the traced contour around a vertex votes its far side wrong) would otherwise
+/// win a wedge of the flood running out to the mesh's end. Vertices no seed reaches (other
+/// components) are not relief. Open contours should end on the mesh boundary.
 std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint>& contour, bool closed,
                                 bool inside_left);
 
