@@ -197,47 +197,48 @@ std::vector<char> relief_region(const Mesh& mesh, const std::vector<SurfacePoint
   }
   // A seed on the wrong side (a hairpin of the traced contour that circles a vertex, its fan crossed
   // twice, votes the far side to the other side's sign) wins a wedge of the far side in that flood:
-  // the fronts between it and its neighbours run outwards to the mesh's end (random scan 6191: 764 background vertices, out to 83
-  // edges, with the contour within an edge of the truth). A part of the mesh the cuts close off on
-  // its own whose seeds are almost all on one side is that side, but for single seeds that won
-  // nothing beyond themselves; where the sides are mixed, a trace gap joined them, and the flood's
-  // labels stand.
+  // the fronts between it and its neighbours run outwards to the mesh's end (random scan 6191: 764
+  // background vertices, out to 83 edges, with the contour within an edge of the truth). A part of
+  // the mesh the cuts close off whose seeds are almost all on one side is that side, but for single
+  // seeds that won nothing beyond themselves; where the sides are mixed, a trace gap joined them, and
+  // the flood's labels stand.
+  // The vertices connected to `from` over uncut edges that `joins` accepts, marked with `from` in
+  // `mark` (#V, -1: not yet), into `out`; returns how many of them are seeds.
+  auto grow = [&](int from, std::vector<int>& mark, auto joins, std::vector<int>& out) {
+    out.assign(1, from);
+    mark[from] = from;
+    int seeds = 0;
+    for (std::size_t head = 0; head < out.size(); ++head) {
+      const int u = out[head];
+      seeds += cutter.vote[u] != 0 ? 1 : 0;
+      for (const int* w = mesh.neighbors_begin(u); w != mesh.neighbors_end(u); ++w) {
+        if (mark[*w] >= 0 || !joins(*w) || cutter.is_cut(u, *w)) continue;
+        mark[*w] = from;
+        out.push_back(*w);
+      }
+    }
+    return seeds;
+  };
   std::vector<int> part(nv, -1), members, patch(nv, -1), patch_members;
   for (int start = 0; start < nv; ++start) {
     if (part[start] >= 0) continue;
-    members.assign(1, start);
-    part[start] = start;
+    grow(start, part, [](int) { return true; }, members);
     int left_seeds = 0, right_seeds = 0;
-    for (std::size_t head = 0; head < members.size(); ++head) {
-      const int u = members[head];
+    for (const int u : members) {
       left_seeds += cutter.vote[u] > 0 ? 1 : 0;
       right_seeds += cutter.vote[u] < 0 ? 1 : 0;
-      for (const int* w = mesh.neighbors_begin(u); w != mesh.neighbors_end(u); ++w) {
-        if (part[*w] >= 0 || cutter.is_cut(u, *w)) continue;
-        part[*w] = start;
-        members.push_back(*w);
-      }
     }
     const int majority = std::max(left_seeds, right_seeds), minority = std::min(left_seeds, right_seeds);
     if (minority == 0 || kMinorityShare * majority < minority) continue;
-    // The minority's patches (connected, same label) that grew past their own seeds. A seed that
-    // won only itself is a local mislabel at the contour and stays as the flood left it.
+    // The minority's patches (connected, same label) that grew past their own seeds. A seed that won
+    // only itself is a local mislabel at the contour and stays as the flood left it. (A part with
+    // seeds is labelled whole by the flood: it is connected over uncut edges.)
     const char side = left_seeds > right_seeds ? kLeft : kRight;
     for (const int u : members) {
-      if (label[u] == side || label[u] == kUnknown || patch[u] >= 0) continue;
-      patch_members.assign(1, u);
-      patch[u] = u;
-      std::size_t seeds = 0;
-      for (std::size_t head = 0; head < patch_members.size(); ++head) {
-        const int x = patch_members[head];
-        seeds += cutter.vote[x] != 0 ? 1 : 0;
-        for (const int* w = mesh.neighbors_begin(x); w != mesh.neighbors_end(x); ++w) {
-          if (patch[*w] >= 0 || label[*w] != label[u] || cutter.is_cut(x, *w)) continue;
-          patch[*w] = u;
-          patch_members.push_back(*w);
-        }
-      }
-      if (patch_members.size() > seeds)
+      if (label[u] == side || patch[u] >= 0) continue;
+      const char minority_label = label[u];
+      const int seeds = grow(u, patch, [&](int w) { return label[w] == minority_label; }, patch_members);
+      if (static_cast<int>(patch_members.size()) > seeds)
         for (const int x : patch_members) label[x] = side;
     }
   }
